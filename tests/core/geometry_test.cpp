@@ -29,7 +29,8 @@ TEST(RotationAngle, AccurateForTinyAngles) {
 }
 
 TEST(Orthonormalize, ReturnsNearestRotation) {
-  const Eigen::Matrix3d C = Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  const Eigen::Matrix3d C =
+      Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
   Eigen::Matrix3d noisy = C;
   noisy(0, 1) += 1e-5;  // a 3x4 file printed with few digits is not exactly orthonormal
   const Eigen::Matrix3d R = orthonormalize(noisy);

@@ -82,8 +82,8 @@ std::vector<std::string_view> splitFields(std::string_view line, char delimiter)
   std::size_t start = 0;
   while (true) {
     const std::size_t end = line.find(delimiter, start);
-    std::string_view f = line.substr(start, end == std::string_view::npos ? line.size() - start
-                                                                          : end - start);
+    std::string_view f =
+        line.substr(start, end == std::string_view::npos ? line.size() - start : end - start);
     while (!f.empty() && is_space(f.front())) f.remove_prefix(1);
     while (!f.empty() && is_space(f.back())) f.remove_suffix(1);
     out.push_back(f);

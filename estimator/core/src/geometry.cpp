@@ -47,7 +47,9 @@ Eigen::Vector3d logSO3(const Eigen::Matrix3d& C) {
   return angle * axis;
 }
 
-bool allFinite(const Isometry3& T) { return T.matrix().allFinite(); }
+bool allFinite(const Isometry3& T) {
+  return T.matrix().allFinite();
+}
 
 }  // namespace sunvo
 

@@ -37,7 +37,9 @@ bool parseInt(std::string_view s, int& out) {
   return ec == std::errc() && ptr == end;
 }
 
-bool isLeap(int y) { return (y % 4 == 0 && y % 100 != 0) || y % 400 == 0; }
+bool isLeap(int y) {
+  return (y % 4 == 0 && y % 100 != 0) || y % 400 == 0;
+}
 
 }  // namespace
 
@@ -61,8 +63,8 @@ Expected<TimeNs> parseCivilTime(std::string_view text, std::int64_t utc_offset_s
     return parseError("time '" + shown + "': " + why +
                       " (expected YYYY-MM-DD HH:MM:SS[.fffffffff])");
   };
-  if (text.size() < 19 || text[4] != '-' || text[7] != '-' || (text[10] != ' ' && text[10] != 'T') ||
-      text[13] != ':' || text[16] != ':') {
+  if (text.size() < 19 || text[4] != '-' || text[7] != '-' ||
+      (text[10] != ' ' && text[10] != 'T') || text[13] != ':' || text[16] != ':') {
     return bad("bad layout");
   }
   int y = 0, mo = 0, d = 0, h = 0, mi = 0, s = 0;

@@ -13,7 +13,7 @@ struct StereoObservation {
   std::int64_t landmark_id = -1;  // persists across frames while the feature is tracked
   double u_left = 0.0;            // px, rectified left image
   double v_left = 0.0;
-  double u_right = 0.0;           // px, rectified right image (v_right ~ v_left after rectification)
+  double u_right = 0.0;  // px, rectified right image (v_right ~ v_left after rectification)
   double v_right = 0.0;
   double disparity() const { return u_left - u_right; }
 };

@@ -11,12 +11,12 @@ namespace sunvo {
 
 enum class StatusCode {
   kOk = 0,
-  kInvalidArgument,  // bad input: a config value, a malformed line, an out-of-range parameter
-  kNotFound,         // a missing file, frame or key
-  kParseError,       // a file whose content does not follow its format
-  kIoError,          // a read or write that failed at the OS level
-  kDeviceError,      // a device fault (V4L2, GPIO, serial)
-  kTimeout,          // a deadline passed
+  kInvalidArgument,     // bad input: a config value, a malformed line, an out-of-range parameter
+  kNotFound,            // a missing file, frame or key
+  kParseError,          // a file whose content does not follow its format
+  kIoError,             // a read or write that failed at the OS level
+  kDeviceError,         // a device fault (V4L2, GPIO, serial)
+  kTimeout,             // a deadline passed
   kFailedPrecondition,  // called in the wrong state
   kInternal,
 };
@@ -41,10 +41,18 @@ class [[nodiscard]] Status {
   std::string message_;
 };
 
-inline Status invalidArgument(std::string m) { return {StatusCode::kInvalidArgument, std::move(m)}; }
-inline Status notFound(std::string m) { return {StatusCode::kNotFound, std::move(m)}; }
-inline Status parseError(std::string m) { return {StatusCode::kParseError, std::move(m)}; }
-inline Status ioError(std::string m) { return {StatusCode::kIoError, std::move(m)}; }
+inline Status invalidArgument(std::string m) {
+  return {StatusCode::kInvalidArgument, std::move(m)};
+}
+inline Status notFound(std::string m) {
+  return {StatusCode::kNotFound, std::move(m)};
+}
+inline Status parseError(std::string m) {
+  return {StatusCode::kParseError, std::move(m)};
+}
+inline Status ioError(std::string m) {
+  return {StatusCode::kIoError, std::move(m)};
+}
 inline Status failedPrecondition(std::string m) {
   return {StatusCode::kFailedPrecondition, std::move(m)};
 }
@@ -53,7 +61,7 @@ inline Status failedPrecondition(std::string m) {
 template <typename T>
 class [[nodiscard]] Expected {
  public:
-  Expected(T value) : value_(std::move(value)) {}  // NOLINT(google-explicit-constructor)
+  Expected(T value) : value_(std::move(value)) {}          // NOLINT(google-explicit-constructor)
   Expected(Status status) : status_(std::move(status)) {}  // NOLINT(google-explicit-constructor)
 
   bool hasValue() const { return value_.has_value(); }
@@ -75,8 +83,8 @@ class [[nodiscard]] Expected {
 }  // namespace sunvo
 
 // Propagates a failed Status from an expression returning Status.
-#define SUNVO_RETURN_IF_ERROR(expr)          \
-  do {                                       \
-    ::sunvo::Status sunvo_status_ = (expr);  \
+#define SUNVO_RETURN_IF_ERROR(expr)                  \
+  do {                                               \
+    ::sunvo::Status sunvo_status_ = (expr);          \
     if (!sunvo_status_.isOk()) return sunvo_status_; \
   } while (false)

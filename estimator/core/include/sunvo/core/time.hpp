@@ -14,7 +14,9 @@ using TimeNs = std::int64_t;
 
 inline constexpr TimeNs kNsPerSecond = 1'000'000'000;
 
-inline constexpr double toSeconds(TimeNs t) { return static_cast<double>(t) * 1e-9; }
+inline constexpr double toSeconds(TimeNs t) {
+  return static_cast<double>(t) * 1e-9;
+}
 
 // Civil date/time -> ns since epoch, treating the fields as UTC (proleptic Gregorian).
 TimeNs civilToUtcNs(int year, int month, int day, int hour, int minute, int second,
