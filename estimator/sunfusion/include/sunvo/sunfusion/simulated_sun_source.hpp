@@ -1,0 +1,54 @@
+#pragma once
+// A sun source for ablations: the true sun direction in the camera frame (from ground truth) with
+// a configurable error model, emulating the error statistics of image-based sun estimators.
+//
+// Angles are taken in the camera frame: azimuth psi = atan2(x, z) in the x-z plane (0 = straight
+// ahead, positive to the right) and zenith zeta = acos(-y), measured from the camera's up (-y).
+// Errors are drawn per measurement, in order:
+//   dropout (no measurement) -> gross outlier (uniform azimuth, zenith uniform over the upper
+//   hemisphere) -> shadow ambiguity flip (psi + 180 deg, the bimodal shadow cue) -> Gaussian
+//   azimuth and zenith errors, the zenith with a bias (Lalonde's zenith prior skews it).
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <optional>
+#include <random>
+
+#include "sunvo/core/status.hpp"
+#include "sunvo/sunfusion/sun_measurement.hpp"
+
+namespace sunvo::sunfusion {
+
+struct SunErrorModel {
+  double azimuth_sigma_deg = 10.0;  // Gaussian azimuth error, [0, 180] deg
+  double zenith_sigma_deg = 5.0;    // Gaussian zenith error, [0, 90] deg
+  double zenith_bias_deg = 0.0;     // mean zenith error, [-45, 45] deg
+  double outlier_share = 0.0;       // share of uniformly random directions, [0, 1]
+  double flip_share = 0.0;          // share with azimuth mirrored by 180 deg, [0, 1]
+  double dropout_share = 0.0;       // share of frames without a measurement, [0, 1]
+  bool azimuth_only = false;        // emit kAzimuthOnly measurements (Sun-CNN)
+  double reported_sigma = 0.15;     // sigma written into each measurement (sets R_s), (0, 2]
+  std::uint32_t seed = 1;           // RNG seed
+
+  Status validate() const;
+};
+
+class SimulatedSunSource {
+ public:
+  explicit SimulatedSunSource(const SunErrorModel& model) : model_(model), rng_(model.seed) {}
+
+  // A measurement for one frame from the true unit sun vector in that camera frame, or nothing
+  // (dropout). Consumes random numbers in a fixed pattern, so runs are reproducible.
+  std::optional<SunMeasurement> measure(std::uint64_t sequence, TimeNs time_ns,
+                                        const Eigen::Vector3d& true_sun_c);
+
+ private:
+  SunErrorModel model_;
+  std::mt19937_64 rng_;
+};
+
+// Camera-frame azimuth/zenith (radians) <-> unit vector, as defined above.
+Eigen::Vector3d sunFromAzimuthZenith(double azimuth_rad, double zenith_rad);
+void azimuthZenithFromSun(const Eigen::Vector3d& sun_c, double& azimuth_rad, double& zenith_rad);
+
+}  // namespace sunvo::sunfusion

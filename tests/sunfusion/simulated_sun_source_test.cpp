@@ -1,0 +1,89 @@
+#include "sunvo/sunfusion/simulated_sun_source.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+namespace sunvo::sunfusion {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+double wrap(double a) {
+  return std::remainder(a, 2.0 * M_PI);
+}
+
+TEST(SimulatedSunSource, AzimuthZenithRoundTrip) {
+  for (double az = -170.0; az <= 170.0; az += 20.0) {
+    for (double zen = 5.0; zen <= 175.0; zen += 10.0) {
+      double a = 0, z = 0;
+      azimuthZenithFromSun(sunFromAzimuthZenith(az * kDeg, zen * kDeg), a, z);
+      EXPECT_NEAR(a, az * kDeg, 1e-12);
+      EXPECT_NEAR(z, zen * kDeg, 1e-12);
+    }
+  }
+}
+
+TEST(SimulatedSunSource, ErrorStatisticsMatchTheModel) {
+  SunErrorModel model;
+  model.azimuth_sigma_deg = 12.0;
+  model.zenith_sigma_deg = 6.0;
+  model.zenith_bias_deg = 4.0;
+  model.dropout_share = 0.2;
+  model.flip_share = 0.1;
+  ASSERT_TRUE(model.validate().isOk());
+  SimulatedSunSource source(model);
+  const Eigen::Vector3d truth = sunFromAzimuthZenith(30.0 * kDeg, 50.0 * kDeg);
+  int n = 0, dropped = 0, flipped = 0;
+  double sum_az2 = 0, sum_zen = 0, sum_zen2 = 0;
+  for (int i = 0; i < 20000; ++i) {
+    auto m = source.measure(static_cast<std::uint64_t>(i), 0, truth);
+    if (!m) {
+      ++dropped;
+      continue;
+    }
+    EXPECT_NEAR(m->sun_c.norm(), 1.0, 1e-12);
+    double a = 0, z = 0;
+    azimuthZenithFromSun(m->sun_c, a, z);
+    const double da = wrap(a - 30.0 * kDeg);
+    if (std::abs(da) > 90.0 * kDeg) {
+      ++flipped;
+      continue;
+    }
+    ++n;
+    sum_az2 += da * da;
+    sum_zen += z - 50.0 * kDeg;
+    sum_zen2 += (z - 50.0 * kDeg) * (z - 50.0 * kDeg);
+  }
+  EXPECT_NEAR(dropped / 20000.0, 0.2, 0.01);
+  EXPECT_NEAR(flipped / 16000.0, 0.1, 0.01);
+  EXPECT_NEAR(std::sqrt(sum_az2 / n) / kDeg, 12.0, 0.4);
+  const double mean_zen = sum_zen / n;
+  EXPECT_NEAR(mean_zen / kDeg, 4.0, 0.2);
+  EXPECT_NEAR(std::sqrt(sum_zen2 / n - mean_zen * mean_zen) / kDeg, 6.0, 0.2);
+}
+
+TEST(SimulatedSunSource, AzimuthOnlyLiesInThePlaneAndIsReproducible) {
+  SunErrorModel model;
+  model.azimuth_only = true;
+  SimulatedSunSource a(model), b(model);
+  const Eigen::Vector3d truth = sunFromAzimuthZenith(-45.0 * kDeg, 30.0 * kDeg);
+  for (int i = 0; i < 100; ++i) {
+    auto ma = a.measure(1, 0, truth);
+    auto mb = b.measure(1, 0, truth);
+    ASSERT_TRUE(ma && mb);
+    EXPECT_EQ(ma->kind, SunMeasurementKind::kAzimuthOnly);
+    EXPECT_NEAR(ma->sun_c.y(), 0.0, 1e-12);
+    EXPECT_EQ(ma->sun_c, mb->sun_c);
+  }
+}
+
+TEST(SimulatedSunSource, ValidationNamesTheKey) {
+  SunErrorModel model;
+  model.flip_share = 2.0;
+  EXPECT_NE(model.validate().message().find("sun_error.flip_share"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace sunvo::sunfusion
