@@ -18,7 +18,7 @@ namespace sunvo::sun {
 // the rover does not measure, and the report's model is a yearly-mean approximation; (2) the
 // model switches off at the horizon limit, so the refracted direction has a step there, which
 // a residual in a bundle adjustment should not see; (3) the image-based sun estimators are
-// accurate to degrees, while refraction is 0.03 deg at 60 deg zenith and 0.1 deg at 80 deg,
+// accurate to degrees, while refraction is 0.03 deg at 60 deg zenith and 0.09 deg at 80 deg,
 // so the apparent-vs-geometric difference is far below the measurement noise except within a
 // few degrees of the horizon, where the sun is rarely usable anyway.
 enum class SunVectorZenith {
