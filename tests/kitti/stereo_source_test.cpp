@@ -135,7 +135,7 @@ TEST(KittiStereoSource, OptionsNameTheBadKey) {
 // 1242x375 images whose pixels encode (frame, camera), and the real image timestamps.
 class RawDrive {
  public:
-  explicit RawDrive(int frames) : frames_(frames) {
+  explicit RawDrive(int frames) {
     fs::create_directories(dir_.file("2011_09_26"));
     for (const char* f :
          {"calib_cam_to_cam.txt", "calib_imu_to_velo.txt", "calib_velo_to_cam.txt"}) {
@@ -178,7 +178,6 @@ class RawDrive {
 
  private:
   testing::TempDir dir_;
-  int frames_;
   std::string drive_;
   std::vector<TimeNs> times_;
 };
