@@ -1,6 +1,7 @@
 #include "sunvo/geodesy_cli/geodesy_csv.hpp"
 
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <string>
 #include <string_view>
@@ -63,7 +64,10 @@ Status convertGeodesyCsv(files::TextFile& in, std::ostream& out) {
     if (!enu) return in.lineError(enu.status().message());
     for (std::size_t i = 0; i < fields.size(); ++i) out << fields[i] << ',';
     std::array<char, 96> buf{};
-    std::snprintf(buf.data(), buf.size(), "%.6f,%.6f,%.6f\n", enu->x(), enu->y(), enu->z());
+    // Values that round to zero print as "0.000000", never "-0.000000".
+    auto tidy = [](double m) { return std::abs(m) < 5e-7 ? 0.0 : m; };
+    std::snprintf(buf.data(), buf.size(), "%.6f,%.6f,%.6f\n", tidy(enu->x()), tidy(enu->y()),
+                  tidy(enu->z()));
     out << buf.data();
   }
   if (!have_header) return parseError(in.path() + ": empty input (no header line)");
