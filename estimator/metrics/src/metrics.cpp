@@ -12,13 +12,34 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kRadToDeg = 180.0 / M_PI;
 
+// The angle between two rotations, rotationAngle(A^T B), with the product written out so that
+// its coefficient (i, j) = Σ_k A(k,i) B(k,j) is summed in the same order as (j, i). When A and B
+// are bitwise equal, A^T A is then exactly symmetric, vee(M - M^T) = 0 and the angle is exactly
+// 0; Eigen's vectorised product does not promise that symmetry (it left 1e-19 rad residues).
+double angleBetween(const Eigen::Matrix3d& A, const Eigen::Matrix3d& B) {
+  Eigen::Matrix3d M;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      M(i, j) = A(0, i) * B(0, j) + A(1, i) * B(1, j) + A(2, i) * B(2, j);
+    }
+  }
+  return rotationAngle(M);
+}
+
 // The relative motion error of one pair (i, j):
-//   E = (T_gt,i^-1 T_gt,j)^-1 (T_est,i^-1 T_est,j).
-Isometry3 relativeError(const Isometry3& gt_i, const Isometry3& gt_j, const Isometry3& est_i,
+//   E = (T_gt,i^-1 T_gt,j)^-1 (T_est,i^-1 T_est,j) = D_gt^-1 D_est,
+//   D = [R_D | t_D]:  E = [R_gt^T R_est | R_gt^T (t_est - t_gt)],
+// so |translation(E)| = |t_est - t_gt| and angle(E) = angleBetween(R_gt, R_est).
+struct PairError {
+  double translation_m = 0.0;
+  double angle_rad = 0.0;
+};
+PairError relativeError(const Isometry3& gt_i, const Isometry3& gt_j, const Isometry3& est_i,
                         const Isometry3& est_j) {
   const Isometry3 d_gt = gt_i.inverse(Eigen::Isometry) * gt_j;
   const Isometry3 d_est = est_i.inverse(Eigen::Isometry) * est_j;
-  return d_gt.inverse(Eigen::Isometry) * d_est;
+  return {(d_est.translation() - d_gt.translation()).norm(),
+          angleBetween(d_gt.linear(), d_est.linear())};
 }
 
 }  // namespace
@@ -94,8 +115,15 @@ Expected<Table1Metrics> computeTable1(const std::vector<Isometry3>& T_w_c_gt,
   SUNVO_RETURN_IF_ERROR(validateTrajectories(T_w_c_gt, T_w_c_est));
   const std::size_t n = T_w_c_gt.size();
   const auto [ia, ib] = planeAxes(plane);
-  // Re-anchoring: T'_est,k = T_gt,0 T_est,0^-1 T_est,k (see the header).
-  const Isometry3 anchor = T_w_c_gt.front() * T_w_c_est.front().inverse(Eigen::Isometry);
+  // Computed in the equivalent relative form of the header (each trajectory in its own first
+  // frame, the difference rotated back into the world by C_gt,0):
+  //   Δp_k = C_gt,0 (C_est,0^T (p_est,k - p_est,0) - C_gt,0^T (p_gt,k - p_gt,0)),
+  //   θ_k  = angle(X_est X_gt^T) = angle(X_gt^T X_est),  X = C_0^T C_k  (the angle is invariant
+  //          under conjugation by X_gt). Bitwise-equal rotations give exactly θ_k = 0.
+  const Eigen::Matrix3d C_gt0 = T_w_c_gt.front().linear();
+  const Eigen::Matrix3d C_est0 = T_w_c_est.front().linear();
+  const Eigen::Vector3d p_gt0 = T_w_c_gt.front().translation();
+  const Eigen::Vector3d p_est0 = T_w_c_est.front().translation();
 
   Table1Metrics m;
   m.plane = plane;
@@ -105,12 +133,14 @@ Expected<Table1Metrics> computeTable1(const std::vector<Isometry3>& T_w_c_gt,
   double sum_r = 0.0;
   Eigen::Vector3d dp_last = Eigen::Vector3d::Zero();
   for (std::size_t k = 0; k < n; ++k) {
-    const Isometry3 est = anchor * T_w_c_est[k];
-    const Eigen::Vector3d dp = est.translation() - T_w_c_gt[k].translation();
-    const Eigen::Matrix3d dC = est.linear() * T_w_c_gt[k].linear().transpose();
+    const Eigen::Vector3d rel_est = C_est0.transpose() * (T_w_c_est[k].translation() - p_est0);
+    const Eigen::Vector3d rel_gt = C_gt0.transpose() * (T_w_c_gt[k].translation() - p_gt0);
+    const Eigen::Vector3d dp = C_gt0 * (rel_est - rel_gt);
+    const Eigen::Matrix3d X_est = C_est0.transpose() * T_w_c_est[k].linear();
+    const Eigen::Matrix3d X_gt = C_gt0.transpose() * T_w_c_gt[k].linear();
     sum_t += std::sqrt(dp.squaredNorm() / 3.0);
     sum_plane += std::sqrt((dp(ia) * dp(ia) + dp(ib) * dp(ib)) / 2.0);
-    sum_r += rotationAngle(dC) / std::sqrt(3.0);
+    sum_r += angleBetween(X_gt, X_est) / std::sqrt(3.0);  // angle(X_est X_gt^T), conjugated
     dp_last = dp;
   }
   const double nd = static_cast<double>(n);
@@ -159,10 +189,10 @@ Expected<KittiSegmentMetrics> computeKittiSegments(const std::vector<Isometry3>&
                                        dist.end(), dist[first] + len);
       if (it == dist.end()) continue;
       const std::size_t last = static_cast<std::size_t>(it - dist.begin());
-      const Isometry3 E =
+      const PairError e =
           relativeError(T_w_c_gt[first], T_w_c_gt[last], T_w_c_est[first], T_w_c_est[last]);
-      sum_t[li] += E.translation().norm() / len;
-      sum_r[li] += rotationAngle(E.linear()) / len;
+      sum_t[li] += e.translation_m / len;
+      sum_r[li] += e.angle_rad / len;
       ++count[li];
     }
   }
@@ -241,7 +271,7 @@ Expected<ApeMetrics> computeApe(const std::vector<Isometry3>& T_w_c_gt,
   for (std::size_t k = 0; k < T_w_c_gt.size(); ++k) {
     const Isometry3 est = A * T_w_c_est[k];
     e_t.push_back((T_w_c_gt[k].translation() - est.translation()).norm());
-    e_r.push_back(rotationAngle(T_w_c_gt[k].linear().transpose() * est.linear()));
+    e_r.push_back(angleBetween(T_w_c_gt[k].linear(), est.linear()));
   }
   return ApeMetrics{summarize(std::move(e_t)), summarize(std::move(e_r))};
 }
@@ -252,9 +282,9 @@ Expected<RpeMetrics> computeRpePerFrame(const std::vector<Isometry3>& T_w_c_gt,
   std::vector<double> e_t;
   std::vector<double> e_r;
   for (std::size_t i = 0; i + 1 < T_w_c_gt.size(); ++i) {
-    const Isometry3 E = relativeError(T_w_c_gt[i], T_w_c_gt[i + 1], T_w_c_est[i], T_w_c_est[i + 1]);
-    e_t.push_back(E.translation().norm());
-    e_r.push_back(rotationAngle(E.linear()));
+    const PairError e = relativeError(T_w_c_gt[i], T_w_c_gt[i + 1], T_w_c_est[i], T_w_c_est[i + 1]);
+    e_t.push_back(e.translation_m);
+    e_r.push_back(e.angle_rad);
   }
   return RpeMetrics{0.0, summarize(std::move(e_t)), summarize(std::move(e_r))};
 }
@@ -274,9 +304,9 @@ Expected<RpeMetrics> computeRpePerDistance(const std::vector<Isometry3>& T_w_c_g
                                      dist[i] + distance_m);
     if (it == dist.end()) break;  // later starts have even less distance left
     const std::size_t j = static_cast<std::size_t>(it - dist.begin());
-    const Isometry3 E = relativeError(T_w_c_gt[i], T_w_c_gt[j], T_w_c_est[i], T_w_c_est[j]);
-    e_t.push_back(E.translation().norm());
-    e_r.push_back(rotationAngle(E.linear()));
+    const PairError e = relativeError(T_w_c_gt[i], T_w_c_gt[j], T_w_c_est[i], T_w_c_est[j]);
+    e_t.push_back(e.translation_m);
+    e_r.push_back(e.angle_rad);
   }
   return RpeMetrics{distance_m, summarize(std::move(e_t)), summarize(std::move(e_r))};
 }
