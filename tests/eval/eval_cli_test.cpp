@@ -3,8 +3,10 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <random>
 #include <sstream>
 #include <string>
 
@@ -110,6 +112,65 @@ TEST(EvalCli, BadArgumentsAndFilesExitWithCode2) {
     const CliResult r = runEval(c.args);
     EXPECT_EQ(r.code, 2) << c.args;
     EXPECT_NE(r.err.find(c.message), std::string::npos) << c.args << "\n" << r.err;
+  }
+}
+
+// The number after the first "key": that follows `anchor` in a JSON text (NaN when absent).
+double numberAfter(const std::string& json, const std::string& anchor, const std::string& key) {
+  const std::size_t from = json.find(anchor);
+  if (from == std::string::npos) return std::nan("");
+  const std::string pattern = "\"" + key + "\": ";
+  const std::size_t at = json.find(pattern, from);
+  if (at == std::string::npos) return std::nan("");
+  return std::strtod(json.c_str() + at + pattern.size(), nullptr);
+}
+
+// sunvo_eval against scripts/reference_metrics.py (Python standard library, quaternions, no
+// shared code) on the real 00 ground truth and a copy that drifts like VO: every frame-to-frame
+// motion perturbed by a random rotation (σ = 2e-4 rad per axis) and translation (σ = 5 mm).
+TEST(EvalCli, AgreesWithIndependentPythonReference) {
+  if (std::system("python3 -c pass > /dev/null 2>&1") != 0) GTEST_SKIP() << "no python3";
+  auto gt = files::readKittiPoses(kGt);
+  ASSERT_TRUE(gt);
+  std::mt19937 rng(7);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  files::Trajectory est;
+  est.T_w_c.push_back(gt->T_w_c.front());
+  for (std::size_t k = 1; k < gt->size(); ++k) {
+    Isometry3 noise = Isometry3::Identity();
+    noise.linear() = expSO3(2e-4 * Eigen::Vector3d(n01(rng), n01(rng), n01(rng)));
+    noise.translation() = 5e-3 * Eigen::Vector3d(n01(rng), n01(rng), n01(rng));
+    est.T_w_c.push_back(est.T_w_c.back() * gt->T_w_c[k - 1].inverse(Eigen::Isometry) *
+                        gt->T_w_c[k] * noise);
+  }
+  const std::string est_path = kTmp + "00_drift.txt";
+  ASSERT_TRUE(files::writeKittiPoses(est_path, est).isOk());
+  for (const std::string plane : {"xz", "en"}) {
+    const std::string json_path = kTmp + "drift_" + plane + ".json";
+    const CliResult r = runEval("--gt " + kGt + " --est drift=" + est_path + " --plane " + plane +
+                                " --json " + json_path);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const std::string ref_path = kTmp + "drift_ref_" + plane + ".json";
+    const std::string cmd = "python3 " + std::string(SUNVO_SOURCE_DIR) +
+                            "/scripts/reference_metrics.py " + kGt + " " + est_path + " " + plane +
+                            " > " + ref_path;
+    ASSERT_EQ(std::system(cmd.c_str()), 0);
+    const std::string ours = slurp(json_path);
+    const std::string ref = slurp(ref_path);
+    for (const char* key :
+         {"trans_armse_m", "trans_armse_plane_m", "rot_armse_rad", "gt_path_length_m",
+          "final_drift_m", "final_drift_pct", "final_drift_plane_m", "final_drift_plane_pct"}) {
+      const double a = numberAfter(ours, "\"table1\"", key);
+      const double b = numberAfter(ref, "\"table1\"", key);
+      ASSERT_TRUE(std::isfinite(a) && std::isfinite(b) && b > 0.0) << key;
+      EXPECT_NEAR(a, b, 1e-9 * b) << plane << " " << key;  // measured: ~4e-14
+    }
+    for (const char* key : {"num_segments", "t_err_pct", "r_err_deg_per_m"}) {
+      const double a = numberAfter(ours, "\"kitti_segments\"", key);
+      const double b = numberAfter(ref, "\"kitti_segments\"", key);
+      ASSERT_TRUE(std::isfinite(a) && std::isfinite(b) && b > 0.0) << key;
+      EXPECT_NEAR(a, b, 1e-9 * b) << plane << " " << key;  // measured: ~4e-14
+    }
   }
 }
 
