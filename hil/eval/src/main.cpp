@@ -135,6 +135,18 @@ int run(int argc, char** argv) {
   sunvo::report::ReportInput input;
   input.gt_path = args->gt;
   input.num_poses = gt->size();
+  input.gt_duration_s = sunvo::toSeconds(gt->t_ns.back() - gt->t_ns.front());
+  if (!args->gt_times.empty()) {
+    input.gt_times_source = "times file " + args->gt_times;
+  } else {
+    auto probe = sunvo::files::TextFile::open(args->gt);
+    bool tum = false;
+    if (probe) {
+      const auto format = sunvo::files::detectTrajectoryFormat(*probe);
+      tum = format && *format == sunvo::files::TrajectoryFormat::kTum;
+    }
+    input.gt_times_source = tum ? "TUM file" : "nominal 10 Hz (KITTI file without times)";
+  }
   input.plane = args->plane;
   std::vector<sunvo::report::PlotSeries> series;
   for (const EstimateArg& e : args->estimates) {

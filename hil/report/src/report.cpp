@@ -157,6 +157,8 @@ std::string evaluationJson(const ReportInput& input) {
   w.key("ground_truth").beginObject();
   w.key("path").value(input.gt_path);
   w.key("num_poses").value(static_cast<std::uint64_t>(input.num_poses));
+  w.key("duration_s").value(input.gt_duration_s);
+  w.key("times").value(input.gt_times_source);
   if (!input.estimates.empty()) {
     w.key("path_length_m").value(input.estimates.front().evaluation.table1.gt_path_length_m);
   }

@@ -3,6 +3,7 @@
 // summary, and every metric of every estimate as JSON. Text only; writing files is the caller's
 // job (files::writeWholeFile).
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,9 @@ struct EstimateReport {
 struct ReportInput {
   std::string gt_path;  // where the ground truth came from (may be empty)
   std::size_t num_poses = 0;
+  // Last minus first ground-truth time [s]; NaN when unknown (written as null).
+  double gt_duration_s = std::numeric_limits<double>::quiet_NaN();
+  std::string gt_times_source;  // where the times came from, e.g. "times file", "nominal 10 Hz"
   metrics::HorizontalPlane plane = metrics::HorizontalPlane::kCameraXZ;
   std::vector<EstimateReport> estimates;
 };
