@@ -1,0 +1,72 @@
+#pragma once
+// Puts sun measurements into the bundle window (the paper's Eq. 3).
+//
+// For a frame k with a measurement s_k, the window's hook is called during solve(). With the
+// window's fixed base pose T_w_b and the current estimate C_k_b it predicts the sun in camera k,
+//   s_hat_k = C_k_b C_b_w s_w,
+// gates the measurement against that prediction (sun_gate.hpp), and when accepted adds the 3-D
+// or azimuth-only residual (sun_residual.hpp) on the rotation block of slot k. The decision is
+// made once per measurement (at its first solve) and counted. s_w is given per measurement in
+// the VO world frame, computed per frame by the caller (the sun moves ~0.25 deg/min).
+//
+// Nothing here allocates per frame except the cost function of an accepted measurement (every
+// fifth frame by default), which lives until it leaves the window.
+
+#include <array>
+#include <memory>
+#include <optional>
+
+#include <ceres/loss_function.h>
+
+#include "sunvo/backend/bundle_window.hpp"
+#include "sunvo/sunfusion/sun_gate.hpp"
+#include "sunvo/sunfusion/sun_measurement.hpp"
+
+namespace sunvo::sunfusion {
+
+struct SunObservation {
+  SunMeasurement measurement;  // in camera k (k = measurement.sequence)
+  Eigen::Vector3d sun_w = Eigen::Vector3d::UnitZ();  // unit vector toward the sun, VO world frame
+};
+
+struct SunFusionOptions {
+  SunGateOptions gate;
+  // Unit vector "up" in the VO world frame, for the sun-elevation gate: ENU (0, 0, 1); a KITTI
+  // camera-0 world has up = (0, -1, 0).
+  Eigen::Vector3d world_up = Eigen::Vector3d::UnitZ();
+  // Robust loss on the whitened sun residual: Cauchy scale in sigmas, (0, 100]; 0 = no loss.
+  double loss_scale = 0.0;
+
+  Status validate() const;
+};
+
+class SunWindowTerm {
+ public:
+  Status init(const SunFusionOptions& options);
+  // Installs this term as the window's pose-residual hook.
+  void attach(backend::BundleWindow& window);
+  // Measurement for a frame that is about to be added to the window (or already is).
+  void addObservation(const SunObservation& observation);
+
+  const GateCounters& counters() const { return counters_; }
+  // Result of the gate for the last measurement decided (for logs and the sun thread).
+  std::optional<GateResult> lastDecision() const { return last_decision_; }
+
+ private:
+  struct Pending {
+    SunObservation obs;
+    bool decided = false;
+    bool accepted = false;
+    std::unique_ptr<ceres::CostFunction> cost;
+  };
+  Status onSolve(backend::BundleWindow& window);
+
+  SunFusionOptions options_;
+  std::unique_ptr<ceres::LossFunction> loss_;
+  std::array<Pending, backend::BundleWindow::kMaxWindowSize> pending_;  // ring by sequence
+  std::array<bool, backend::BundleWindow::kMaxWindowSize> used_{};
+  GateCounters counters_;
+  std::optional<GateResult> last_decision_;
+};
+
+}  // namespace sunvo::sunfusion
