@@ -49,23 +49,22 @@ constexpr int kDescriptorReach = 6;  // px, largest |offset|
 // Vertex offset of a parabola through (-1, rm), (0, r0), (1, rp):
 // r(x) = a x^2 + b x + c with a = (rm + rp)/2 - r0, b = (rp - rm)/2; extremum at -b/(2a)
 // = (rm - rp) / (2 (rm - 2 r0 + rp)). Clamped to the pixel it belongs to.
-float parabolaPeak(int rm, int r0, int rp) {
-  const int den = rm - 2 * r0 + rp;
+float parabolaPeak(std::int64_t rm, std::int64_t r0, std::int64_t rp) {
+  const std::int64_t den = rm - 2 * r0 + rp;
   if (den == 0) return 0.0F;
   const float d = 0.5F * static_cast<float>(rm - rp) / static_cast<float>(den);
   return std::clamp(d, -0.5F, 0.5F);
 }
 
-// Minimum of a V-shaped cost through (-1, cm), (0, c0), (1, cp) with c0 the smallest (equiangular
-// line fit, Shimizu & Okutomi): c(x) = k |x - x*|. For x* >= 0: cm = k (1 + x*), c0 = k x*,
-// cp = k (1 - x*), so k = cm - c0 and x* = (cm - cp) / (2 k); symmetric for x* < 0 with
-// k = cp - c0. SAD costs are V-shaped near their minimum, where a parabola biases the
-// estimate toward whole pixels.
-float equiangularPeak(int cm, int c0, int cp) {
-  const int k = (cm >= cp) ? cm - c0 : cp - c0;
-  if (k <= 0) return 0.0F;
-  const float d = 0.5F * static_cast<float>(cm - cp) / static_cast<float>(k);
-  return std::clamp(d, -0.5F, 0.5F);
+// Sum of squared differences of n bytes.
+[[gnu::noinline]] std::int64_t rowSsd(const std::uint8_t* __restrict a,
+                                      const std::uint8_t* __restrict b, int n) {
+  int sum = 0;  // n <= 17 samples of at most 255^2: fits in int
+  for (int i = 0; i < n; ++i) {
+    const int d = int{a[i]} - int{b[i]};
+    sum += d * d;
+  }
+  return sum;
 }
 
 // out_max[i] = max(a[i], b[i]), out_min[i] = min(c[i], d[i]) for i in [0, count). Inputs may
@@ -532,28 +531,43 @@ int StereoFrontend::matchTemporal(const CandidateSet& from, int idx, const Candi
                       kp.cls, cu - r, cu + r, cv - r, cv + r, nullptr);
 }
 
-// The right match is a candidate at whole pixels. Along the row of the left keypoint the SAD of
-// the left descriptor against dense right descriptors is sampled at the candidate and +-2 px;
-// the smallest of the inner three is refined by the equiangular fit with its neighbours. The
-// descriptors compare windows centred on the left keypoint's whole pixel, so the left
-// subpixel offset du carries over to the right: u_right = u_r + s + delta + du.
+// Sum of squared differences of the gradient images (gx and gy) over a dense
+// (2 kRefineRadius + 1)^2 window: left centred at (ul, v), right at (ur, v).
+std::int64_t StereoFrontend::denseCost(int ul, int ur, int v) const {
+  std::int64_t sum = 0;
+  for (int dy = -kRefineRadius; dy <= kRefineRadius; ++dy) {
+    const std::ptrdiff_t row = static_cast<std::ptrdiff_t>(v + dy) * stride_;
+    sum += rowSsd(gx_[0].data() + row + ul - kRefineRadius,
+                  gx_[1].data() + row + ur - kRefineRadius, 2 * kRefineRadius + 1);
+    sum += rowSsd(gy_[0].data() + row + ul - kRefineRadius,
+                  gy_[1].data() + row + ur - kRefineRadius, 2 * kRefineRadius + 1);
+  }
+  return sum;
+}
+
+// The right match is a candidate at whole pixels. Along the row of the left keypoint, the dense
+// SSD of the gradients (denseCost) is sampled at the candidate and +-2 px; the smallest of the
+// inner three is refined by a parabola through it and its neighbours (vertex at
+// (c- - c+) / (2 (c- - 2 c0 + c+)), see parabolaPeak). A dense SSD is used here rather than the
+// SAD of the sparse descriptor: for a dense window the cost of a shift by +1 and by -1 differ only
+// by boundary terms, so the cost is symmetric about its minimum and the parabola is unbiased,
+// whereas the sparse samples make it lopsided (0.2-0.3 px bias measured on exact shifts).
+// The window is centred on the left keypoint's whole pixel, so its subpixel offset du carries
+// over to the right: u_right = u_r + s + delta + du.
 bool StereoFrontend::refineStereo(int li, int ri, StereoObservation& obs) const {
   const CandidateSet& l = left_[static_cast<std::size_t>(cur_)];
   const CandidateSet& r = right_[static_cast<std::size_t>(cur_)];
   const Keypoint& lk = l.kp[static_cast<std::size_t>(li)];
   const Keypoint& rk = r.kp[static_cast<std::size_t>(ri)];
-  const std::uint8_t* dl = l.desc.data() + static_cast<std::ptrdiff_t>(li) * kDescriptorBytes;
-  std::array<int, 5> cost{};
-  alignas(16) std::uint8_t dr[kDescriptorBytes];
+  std::array<std::int64_t, 5> cost{};
   for (int k = -2; k <= 2; ++k) {
-    describeAt(1, rk.u + k, lk.v, dr);
-    cost[static_cast<std::size_t>(k + 2)] = sad32(dl, dr);
+    cost[static_cast<std::size_t>(k + 2)] = denseCost(lk.u, rk.u + k, lk.v);
   }
   int s = 0;
   if (cost[1] < cost[2] && cost[1] <= cost[3]) s = -1;
   if (cost[3] < cost[2] && cost[3] < cost[1]) s = 1;
   const auto c = static_cast<std::size_t>(s + 2);
-  const float delta = equiangularPeak(cost[c - 1], cost[c], cost[c + 1]);
+  const float delta = parabolaPeak(cost[c - 1], cost[c], cost[c + 1]);
   const double u_left = lk.u + static_cast<double>(lk.du);
   const double v_left = lk.v + static_cast<double>(lk.dv);
   const double u_right = rk.u + s + static_cast<double>(delta) + static_cast<double>(lk.du);

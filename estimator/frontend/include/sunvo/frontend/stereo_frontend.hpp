@@ -15,8 +15,8 @@
 //  3. New features: the strongest unused current-left candidates of each bucket (grid of buckets,
 //     at most max_per_bucket features per bucket including tracked ones) that have a left-right
 //     consistent stereo match; they get new ids.
-//  4. Subpixel: the left keypoint by a parabola on its response, the right match by an
-//     equiangular (V) fit on the SAD matching cost along the row.
+//  4. Subpixel: the left keypoint by a parabola on its response, the right match by a parabola
+//     on a dense gradient SSD along the row.
 //
 // Memory: every buffer is allocated in init() from the options (max image size, max candidates,
 // max features). process() performs no heap allocation once `out.observations` has capacity for
@@ -134,7 +134,8 @@ class StereoFrontend {
     std::int32_t left = -1;   // candidate index in that frame's left set
     std::int32_t right = -1;  // candidate index in that frame's right set
   };
-  static constexpr int kCell = 16;  // px, grid index cell size
+  static constexpr int kCell = 16;         // px, grid index cell size
+  static constexpr int kRefineRadius = 4;  // px, half size of the dense subpixel window
   static constexpr int kClasses = 4;
 
   // img_index 0 = left, 1 = right: which gradient buffers are written / read.
@@ -152,6 +153,7 @@ class StereoFrontend {
   int matchRightToLeft(int ri) const;
   int matchTemporal(const CandidateSet& from, int idx, const CandidateSet& to, float shift_u,
                     float shift_v) const;
+  std::int64_t denseCost(int ul, int ur, int v) const;
   // Subpixel u of the right match ri of left candidate li (in the current frame); false if the
   // disparity falls outside the range.
   bool refineStereo(int li, int ri, StereoObservation& obs) const;
