@@ -1,10 +1,12 @@
 #include "sunvo/frontend/stereo_frontend.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <string>
 #include <utility>
 
@@ -14,6 +16,16 @@
 
 namespace sunvo {
 namespace {
+
+static_assert(std::endian::native == std::endian::little,
+              "detect() reads flag bytes as little-endian 64-bit words");
+
+// CPU time of the calling thread (POSIX), ns; the stages are single-threaded.
+std::int64_t threadCpuNs() {
+  timespec ts{};
+  if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) != 0) return 0;
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
 
 std::int64_t nowNs() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(
@@ -57,8 +69,8 @@ float parabolaPeak(std::int64_t rm, std::int64_t r0, std::int64_t rp) {
 }
 
 // Sum of squared differences of n bytes.
-[[gnu::noinline]] std::int64_t rowSsd(const std::uint8_t* __restrict a,
-                                      const std::uint8_t* __restrict b, int n) {
+inline std::int64_t rowSsd(const std::uint8_t* __restrict a, const std::uint8_t* __restrict b,
+                           int n) {
   int sum = 0;  // n <= 17 samples of at most 255^2: fits in int
   for (int i = 0; i < n; ++i) {
     const int d = int{a[i]} - int{b[i]};
@@ -228,6 +240,8 @@ Status StereoFrontend::init(const FrontendOptions& options, const StereoCamera& 
       s = CandidateSet{};
       s.kp.assign(max_cand, Keypoint{});
       s.desc.assign(max_cand * kDescriptorBytes, 0);
+      s.kp_sorted.assign(max_cand, Keypoint{});
+      s.desc_sorted.assign(max_cand * kDescriptorBytes, 0);
       s.cell_start.assign(cells, 0);
       s.order.assign(max_cand, 0);
     }
@@ -366,19 +380,23 @@ void StereoFrontend::detect(const cv::Mat& img_in, int img_index, CandidateSet& 
   const int thresholds[2] = {options_.blob_threshold, options_.corner_threshold};
 
   // true if no pixel of the window beats r(x, y) (sign +1: max, -1: min) or equals it earlier.
-  auto isFirstExtremum = [&](const std::int16_t* r, int x, int y, int sign) {
-    const int c = sign * r[static_cast<std::ptrdiff_t>(y) * stride_ + x];
-    for (int yy = y - n; yy <= y; ++yy) {
-      const std::int16_t* row = r + static_cast<std::ptrdiff_t>(yy) * stride_;
-      const int xe = (yy == y) ? x - 1 : x + n;
-      for (int xx = x - n; xx <= xe; ++xx) {
-        if (sign * row[xx] == c) return false;
-      }
+  // Called where r(x, y) equals the window max (or min), i.e. nothing in the window beats it;
+  // true unless an equal value comes earlier in row-major order. Branch-free inner loop.
+  auto isFirstExtremum = [&](const std::int16_t* r, int x, int y) {
+    const std::int16_t c = r[static_cast<std::ptrdiff_t>(y) * stride_ + x];
+    int equal = 0;
+    for (int yy = y - n; yy < y; ++yy) {
+      const std::int16_t* row = r + static_cast<std::ptrdiff_t>(yy) * stride_ + x - n;
+      for (int k = 0; k <= 2 * n; ++k) equal |= (row[k] == c) ? 1 : 0;
     }
-    return true;
+    const std::int16_t* row = r + static_cast<std::ptrdiff_t>(y) * stride_ + x - n;
+    for (int k = 0; k < n; ++k) equal |= (row[k] == c) ? 1 : 0;
+    return equal == 0;
   };
 
-  const std::ptrdiff_t total = static_cast<std::ptrdiff_t>(h) * stride_;
+  // Only rows b-n .. h-b+n-1 feed the windows of candidate rows b .. h-b-1.
+  const std::ptrdiff_t first = static_cast<std::ptrdiff_t>(b - n) * stride_;
+  const std::ptrdiff_t total = static_cast<std::ptrdiff_t>(h - 2 * b + 2 * n) * stride_;
   const int x0 = b;
   const int x1 = w - b;  // exclusive
   std::uint8_t* flags = flag_row_.data();
@@ -387,9 +405,10 @@ void StereoFrontend::detect(const cv::Mat& img_in, int img_index, CandidateSet& 
     // (2n+1)^2 max and min: horizontal then vertical running max/min.
     const std::array<std::int16_t*, 4> tmp = {nms_a_.data(), nms_b_.data(), nms_c_.data(),
                                               nms_d_.data()};
-    windowMaxMin(r, r, nms_hmax_.data(), nms_hmin_.data(), tmp, 1, n, total);
-    windowMaxMin(nms_hmax_.data(), nms_hmin_.data(), nms_max_.data(), nms_min_.data(), tmp, stride_,
+    windowMaxMin(r + first, r + first, nms_hmax_.data() + first, nms_hmin_.data() + first, tmp, 1,
                  n, total);
+    windowMaxMin(nms_hmax_.data() + first, nms_hmin_.data() + first, nms_max_.data() + first,
+                 nms_min_.data() + first, tmp, stride_, n, total);
     const int thr = thresholds[type];
     const auto pos_thr = static_cast<std::int16_t>(thr);
     const auto neg_thr = static_cast<std::int16_t>(-thr);
@@ -403,34 +422,34 @@ void StereoFrontend::detect(const cv::Mat& img_in, int img_index, CandidateSet& 
         const int is_min = (row[x] == vmin[x]) & (row[x] <= neg_thr);
         flags[x] = static_cast<std::uint8_t>(is_max | (is_min << 1));
       }
-      for (int x = x0; x < x1; ++x) {
-        // Skip 8 flag bytes at a time when all are zero.
-        if ((x & 7) == 0 && x + 8 <= x1) {
-          std::uint64_t word = 0;
-          std::memcpy(&word, flags + x, sizeof(word));
-          if (word == 0) {
-            x += 7;
-            continue;
+      std::memset(flags + x1, 0, 8);  // so that the last 8-byte word reads no stale flags
+      // Visit the non-zero flag bytes, 8 at a time (little-endian: byte i = bits 8i .. 8i+7).
+      for (int xw = x0; xw < x1; xw += 8) {
+        std::uint64_t word = 0;
+        std::memcpy(&word, flags + xw, sizeof(word));
+        while (word != 0) {
+          const int byte = std::countr_zero(word) / 8;
+          word &= ~(std::uint64_t{0xFF} << (8 * byte));
+          const int x = xw + byte;
+          const int f = flags[x];
+          for (int sign = 1; sign >= -1; sign -= 2) {
+            if ((f & (sign > 0 ? 1 : 2)) == 0) continue;
+            if (!isFirstExtremum(r, x, y)) continue;
+            if (set.count >= options_.max_candidates) {
+              set.truncated = true;
+              continue;
+            }
+            Keypoint& kp = set.kp[static_cast<std::size_t>(set.count)];
+            kp.u = static_cast<std::int16_t>(x);
+            kp.v = static_cast<std::int16_t>(y);
+            kp.cls = static_cast<std::uint8_t>(2 * type + (sign > 0 ? 0 : 1));
+            kp.strength = sign * row[x];
+            kp.du = parabolaPeak(row[x - 1], row[x], row[x + 1]);
+            kp.dv = parabolaPeak(row[x - stride_], row[x], row[x + stride_]);
+            describeAt(img_index, x, y,
+                       set.desc.data() + static_cast<std::ptrdiff_t>(set.count) * kDescriptorBytes);
+            ++set.count;
           }
-        }
-        if (flags[x] == 0) continue;
-        for (int sign = 1; sign >= -1; sign -= 2) {
-          if ((flags[x] & (sign > 0 ? 1 : 2)) == 0) continue;
-          if (!isFirstExtremum(r, x, y, sign)) continue;
-          if (set.count >= options_.max_candidates) {
-            set.truncated = true;
-            continue;
-          }
-          Keypoint& kp = set.kp[static_cast<std::size_t>(set.count)];
-          kp.u = static_cast<std::int16_t>(x);
-          kp.v = static_cast<std::int16_t>(y);
-          kp.cls = static_cast<std::uint8_t>(2 * type + (sign > 0 ? 0 : 1));
-          kp.strength = sign * row[x];
-          kp.du = parabolaPeak(row[x - 1], row[x], row[x + 1]);
-          kp.dv = parabolaPeak(row[x - stride_], row[x], row[x + stride_]);
-          describeAt(img_index, x, y,
-                     set.desc.data() + static_cast<std::ptrdiff_t>(set.count) * kDescriptorBytes);
-          ++set.count;
         }
       }
     }
@@ -465,6 +484,16 @@ void StereoFrontend::buildIndex(CandidateSet& set) {
     set.cell_start[static_cast<std::size_t>(c)] = set.cell_start[static_cast<std::size_t>(c + 1)];
   }
   set.cell_start[static_cast<std::size_t>(cells)] = set.count;
+  // Reorder keypoints and descriptors into cell order, so that a window search reads contiguous
+  // memory; candidate indices are cell-ordered from here on.
+  for (int k = 0; k < set.count; ++k) {
+    const auto from = static_cast<std::size_t>(set.order[static_cast<std::size_t>(k)]);
+    set.kp_sorted[static_cast<std::size_t>(k)] = set.kp[from];
+    std::memcpy(set.desc_sorted.data() + static_cast<std::size_t>(k) * kDescriptorBytes,
+                set.desc.data() + from * kDescriptorBytes, kDescriptorBytes);
+  }
+  std::swap(set.kp, set.kp_sorted);
+  std::swap(set.desc, set.desc_sorted);
 }
 
 int StereoFrontend::searchWindow(const CandidateSet& set, const std::uint8_t* d, int cls, int u0,
@@ -482,9 +511,8 @@ int StereoFrontend::searchWindow(const CandidateSet& set, const std::uint8_t* d,
     const int row_base = (cls * set.cells_y + cy) * set.cells_x;
     const int begin = set.cell_start[static_cast<std::size_t>(row_base + cx0)];
     const int end = set.cell_start[static_cast<std::size_t>(row_base + cx1 + 1)];
-    // Cells cx0..cx1 of one row are contiguous in `order`.
-    for (int k = begin; k < end; ++k) {
-      const int i = set.order[static_cast<std::size_t>(k)];
+    // Cells cx0..cx1 of one row are contiguous (candidates are stored in cell order).
+    for (int i = begin; i < end; ++i) {
       const Keypoint& kp = set.kp[static_cast<std::size_t>(i)];
       if (kp.u < u0 || kp.u > u1 || kp.v < v0 || kp.v > v1) continue;
       const int c = sad32(d, set.desc.data() + static_cast<std::ptrdiff_t>(i) * kDescriptorBytes);
@@ -606,6 +634,7 @@ Status StereoFrontend::process(const cv::Mat& left, const cv::Mat& right, TimeNs
 
   stats_ = FrontendStats{};
   const std::int64_t t0 = nowNs();
+  const std::int64_t c0 = threadCpuNs();
   if (have_prev_) cur_ = 1 - cur_;
   const auto cur = static_cast<std::size_t>(cur_);
   const auto prev = static_cast<std::size_t>(1 - cur_);
@@ -629,6 +658,7 @@ Status StereoFrontend::process(const cv::Mat& left, const cv::Mat& right, TimeNs
   std::fill(bucket_count_.begin(), bucket_count_.begin() + buckets, 0);
   const auto max_out = static_cast<std::size_t>(options_.max_features);
   const std::int64_t t1 = nowNs();
+  const std::int64_t c1 = threadCpuNs();
 
   // Tracks: prev-left a -> prev-right b (last frame's stereo match) -> cur-right c (temporal)
   // -> cur-left d (stereo) -> prev-left a2 (temporal); kept iff a2 lies within
@@ -678,6 +708,7 @@ Status StereoFrontend::process(const cv::Mat& left, const cv::Mat& right, TimeNs
   }
   stats_.tracks_kept = static_cast<int>(tracks_cur_.size());
   const std::int64_t t2 = nowNs();
+  const std::int64_t c2 = threadCpuNs();
 
   // New features: per bucket, the strongest unused current-left candidates with a left-right
   // consistent stereo match, until the bucket holds max_per_bucket features.
@@ -736,9 +767,13 @@ Status StereoFrontend::process(const cv::Mat& left, const cv::Mat& right, TimeNs
     }
   }
   const std::int64_t t3 = nowNs();
+  const std::int64_t c3 = threadCpuNs();
   stats_.detect_ns = t1 - t0;
   stats_.temporal_ns = t2 - t1;
   stats_.stereo_ns = t3 - t2;
+  stats_.detect_cpu_ns = c1 - c0;
+  stats_.temporal_cpu_ns = c2 - c1;
+  stats_.stereo_cpu_ns = c3 - c2;
   have_prev_ = true;
   hint_du_ = 0.0F;
   hint_dv_ = 0.0F;

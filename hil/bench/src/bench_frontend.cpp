@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <fstream>
 #include <opencv2/core/utility.hpp>
 #include <string>
@@ -32,6 +33,7 @@ struct Config {
 
 struct Results {
   std::vector<double> detect_ms, temporal_ms, stereo_ms, total_ms;
+  std::vector<double> detect_cpu_ms, temporal_cpu_ms, stereo_cpu_ms, total_cpu_ms;
   std::vector<double> features, tracked, candidates_left;
   std::vector<std::uint64_t> allocs;
   long rss_warm_kb = 0;
@@ -53,6 +55,13 @@ long procStatusKb(const char* key) {
     if (line.compare(0, n, key) == 0) return std::strtol(line.c_str() + n, nullptr, 10);
   }
   return -1;
+}
+
+// CPU time of this thread, ms.
+double threadCpuMs() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
 }
 
 // 0,1,..,10,9,..,1,0,1,.. for 11 frames.
@@ -90,7 +99,8 @@ void benchFrontend(benchmark::State& state) {
   }
   Results& r = g_results;
   const auto frames = static_cast<std::size_t>(g_config.frames);
-  for (auto* v : {&r.detect_ms, &r.temporal_ms, &r.stereo_ms, &r.total_ms, &r.features, &r.tracked,
+  for (auto* v : {&r.detect_ms, &r.temporal_ms, &r.stereo_ms, &r.total_ms, &r.detect_cpu_ms,
+                  &r.temporal_cpu_ms, &r.stereo_cpu_ms, &r.total_cpu_ms, &r.features, &r.tracked,
                   &r.candidates_left}) {
     v->clear();
     v->reserve(frames);
@@ -102,9 +112,11 @@ void benchFrontend(benchmark::State& state) {
   for (auto _ : state) {
     const std::size_t k = pingPong(frame, n);
     const auto t0 = std::chrono::steady_clock::now();
+    const double cpu0 = threadCpuMs();
     const std::uint64_t a0 = sunvo::bench::allocationCount();
     const sunvo::Status s = fe.process(g_sample.left[k], g_sample.right[k], 0, frame, out);
     const std::uint64_t a1 = sunvo::bench::allocationCount();
+    const double cpu1 = threadCpuMs();
     const auto t1 = std::chrono::steady_clock::now();
     if (!s.isOk()) failed = true;
     const sunvo::FrontendStats& fs = fe.lastStats();
@@ -113,6 +125,10 @@ void benchFrontend(benchmark::State& state) {
     r.detect_ms.push_back(static_cast<double>(fs.detect_ns) * 1e-6);
     r.temporal_ms.push_back(static_cast<double>(fs.temporal_ns) * 1e-6);
     r.stereo_ms.push_back(static_cast<double>(fs.stereo_ns) * 1e-6);
+    r.total_cpu_ms.push_back(cpu1 - cpu0);
+    r.detect_cpu_ms.push_back(static_cast<double>(fs.detect_cpu_ns) * 1e-6);
+    r.temporal_cpu_ms.push_back(static_cast<double>(fs.temporal_cpu_ns) * 1e-6);
+    r.stereo_cpu_ms.push_back(static_cast<double>(fs.stereo_cpu_ns) * 1e-6);
     r.features.push_back(static_cast<double>(out.observations.size()));
     r.tracked.push_back(static_cast<double>(fs.tracks_kept));
     r.candidates_left.push_back(static_cast<double>(fs.candidates_left));
@@ -130,6 +146,7 @@ void benchFrontend(benchmark::State& state) {
       static_cast<double>(total_allocs) / static_cast<double>(r.allocs.size());
   state.counters["features"] = percentile(r.features, 0.5);
   state.counters["tracked"] = percentile(r.tracked, 0.5);
+  state.counters["cpu_ms_p50"] = percentile(r.total_cpu_ms, 0.5);
   state.counters["detect_ms_p50"] = percentile(r.detect_ms, 0.5);
   state.counters["temporal_ms_p50"] = percentile(r.temporal_ms, 0.5);
   state.counters["stereo_ms_p50"] = percentile(r.stereo_ms, 0.5);
@@ -143,15 +160,19 @@ void printSummary() {
       "\nfront end on %zu frames of %dx%d (00_first_frames ping-pong), after %d warm-up "
       "frames, single thread (cv::setNumThreads(0))\n",
       r.total_ms.size(), g_sample.camera.width, g_sample.camera.height, g_config.warmup);
-  std::printf("%-28s %9s %9s %9s %9s\n", "stage [ms]", "median", "p95", "p99", "max");
+  std::printf("%-32s %9s %9s %9s %9s\n", "stage [ms]", "median", "p95", "p99", "max");
   auto row = [](const char* name, const std::vector<double>& v) {
-    std::printf("%-28s %9.3f %9.3f %9.3f %9.3f\n", name, percentile(v, 0.5), percentile(v, 0.95),
+    std::printf("%-32s %9.3f %9.3f %9.3f %9.3f\n", name, percentile(v, 0.5), percentile(v, 0.95),
                 percentile(v, 0.99), percentile(v, 1.0));
   };
-  row("detect (both images)", r.detect_ms);
-  row("temporal + circular check", r.temporal_ms);
-  row("stereo match (new feats)", r.stereo_ms);
-  row("process() total", r.total_ms);
+  row("wall: detect (both images)", r.detect_ms);
+  row("wall: temporal + circular", r.temporal_ms);
+  row("wall: stereo match (new)", r.stereo_ms);
+  row("wall: process() total", r.total_ms);
+  row("cpu:  detect (both images)", r.detect_cpu_ms);
+  row("cpu:  temporal + circular", r.temporal_cpu_ms);
+  row("cpu:  stereo match (new)", r.stereo_cpu_ms);
+  row("cpu:  process() total", r.total_cpu_ms);
   std::uint64_t total = 0;
   std::uint64_t worst = 0;
   for (auto a : r.allocs) {

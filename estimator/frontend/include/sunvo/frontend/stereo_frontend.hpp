@@ -59,11 +59,16 @@ struct FrontendOptions {
   Status validate() const;
 };
 
-// What the last process() call did; times from the monotonic clock.
+// What the last process() call did. *_ns: wall time (monotonic clock); *_cpu_ns: CPU time of the
+// calling thread (differs from wall time when the core is shared with other work).
 struct FrontendStats {
-  std::int64_t detect_ns = 0;    // gradients, responses, NMS, descriptors, grid index (2 images)
+  std::int64_t detect_ns = 0;    // smoothing, gradients, responses, NMS, descriptors, grid index
+                                 //   (both images)
   std::int64_t temporal_ns = 0;  // track following around the circle incl. circular check
   std::int64_t stereo_ns = 0;    // new features: bucketing, left<->right matching, subpixel
+  std::int64_t detect_cpu_ns = 0;
+  std::int64_t temporal_cpu_ns = 0;
+  std::int64_t stereo_cpu_ns = 0;
   int candidates_left = 0;
   int candidates_right = 0;
   int tracks_in = 0;                  // features of the previous frame
@@ -115,7 +120,8 @@ class StereoFrontend {
     float dv = 0.0F;
   };
   // Candidates of one image with their descriptors and a grid index (cells of kCell px, per
-  // class): cell_start[c]..cell_start[c+1] index into order.
+  // class): after buildIndex() the candidates are stored in cell order and cell c holds
+  // candidates cell_start[c] .. cell_start[c+1]-1.
   struct CandidateSet {
     int count = 0;
     int width = 0;
@@ -126,7 +132,9 @@ class StereoFrontend {
     std::vector<Keypoint> kp;
     std::vector<std::uint8_t> desc;  // count * kDescriptorBytes
     std::vector<std::int32_t> cell_start;
-    std::vector<std::int32_t> order;
+    std::vector<std::int32_t> order;        // buildIndex scratch: cell-ordered source indices
+    std::vector<Keypoint> kp_sorted;        // buildIndex scratch, swapped with kp
+    std::vector<std::uint8_t> desc_sorted;  // buildIndex scratch, swapped with desc
   };
   // A feature output in a frame, remembered to follow it in the next one.
   struct Track {
