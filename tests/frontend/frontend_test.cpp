@@ -247,6 +247,31 @@ TEST(StereoFrontend, CircularCheckRejectsInjectedInconsistency) {
   EXPECT_GT(wrong_loose, 10);  // what the check removed were wrong tracks
 }
 
+// A shift larger than search_radius is lost without a prior and tracked with the pixel-shift hint.
+TEST(StereoFrontend, PixelShiftHintCentresTheTemporalSearch) {
+  const cv::Mat texture = makeTexture(5);
+  const double d = 10.0;
+  const double tx = 60.0;
+  FrontendOptions opt;
+  opt.search_radius = 30;
+  for (const bool use_hint : {false, true}) {
+    StereoFrontend fe;
+    ASSERT_TRUE(fe.init(opt, syntheticCamera()).isOk());
+    FrameFeatures f;
+    ASSERT_TRUE(fe.process(crop(texture, 0, 0), crop(texture, d, 0), 0, 0, f).isOk());
+    if (use_hint) fe.setPixelShiftHint(static_cast<float>(tx), 0.0F);
+    ASSERT_TRUE(fe.process(crop(texture, -tx, 0), crop(texture, d - tx, 0), 1, 1, f).isOk());
+    std::printf("shift %.0f px, radius %d px, hint %s: %d of %d tracks kept\n", tx,
+                opt.search_radius, use_hint ? "on" : "off", fe.lastStats().tracks_kept,
+                fe.lastStats().tracks_in);
+    if (use_hint) {
+      EXPECT_GT(fe.lastStats().tracks_kept, fe.lastStats().tracks_in / 2);
+    } else {
+      EXPECT_LT(fe.lastStats().tracks_kept, fe.lastStats().tracks_in / 10);
+    }
+  }
+}
+
 TEST(StereoFrontend, IdsPersistOverSeveralFramesAndResetStartsFresh) {
   const cv::Mat texture = makeTexture(4);
   StereoFrontend fe;

@@ -3,9 +3,11 @@
 // OpenCV calls that could spawn threads). Prints per-stage median/p95/p99, heap allocations per
 // frame inside process() after a warm-up, and the resident set size.
 //
-// Usage: sunvo_bench_frontend [--frames=N] [--warmup=N] [--data=DIR] [benchmark flags]
+// Usage: sunvo_bench_frontend [--frames=N] [--warmup=N] [--data=DIR] [--cpu=K] [benchmark flags]
+//   --cpu=K pins the process to CPU K (sched_setaffinity) before anything runs.
 
 #include <benchmark/benchmark.h>
+#include <sched.h>
 
 #include <algorithm>
 #include <chrono>
@@ -29,6 +31,7 @@ struct Config {
   int frames = 500;
   int warmup = 20;
   std::string data = std::string(SUNVO_DATA_DIR) + "/kitti_odometry/00_first_frames";
+  int cpu = -1;  // pin to this CPU when >= 0
 };
 
 struct Results {
@@ -204,11 +207,23 @@ int main(int argc, char** argv) {
       g_config.frames = std::max(1, std::atoi(a.c_str() + 9));
     } else if (a.rfind("--warmup=", 0) == 0) {
       g_config.warmup = std::max(0, std::atoi(a.c_str() + 9));
+    } else if (a.rfind("--cpu=", 0) == 0) {
+      g_config.cpu = std::atoi(a.c_str() + 6);
     } else if (a.rfind("--data=", 0) == 0) {
       g_config.data = a.substr(7);
     } else {
       rest.push_back(argv[i]);
     }
+  }
+  if (g_config.cpu >= 0) {
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    CPU_SET(g_config.cpu, &set);
+    if (sched_setaffinity(0, sizeof(set), &set) != 0) {
+      std::fprintf(stderr, "cannot pin to CPU %d\n", g_config.cpu);
+      return 1;
+    }
+    std::printf("pinned to CPU %d\n", g_config.cpu);
   }
   if (!sunvo::bench::allocCounterActive()) {
     std::fprintf(stderr, "allocation counter is not active in this binary\n");
