@@ -84,6 +84,7 @@ TEST(FrontendOptions, ErrorNamesTheBadKey) {
       {"min_disparity", [](FrontendOptions& o) { o.min_disparity = 300.0; }},
       {"max_disparity", [](FrontendOptions& o) { o.max_disparity = 5000.0; }},
       {"search_radius", [](FrontendOptions& o) { o.search_radius = 2; }},
+      {"predicted_search_radius", [](FrontendOptions& o) { o.predicted_search_radius = 200; }},
       {"max_sad", [](FrontendOptions& o) { o.max_sad = 9000; }},
       {"circular_tolerance_px", [](FrontendOptions& o) { o.circular_tolerance_px = -1.0; }},
   };
@@ -254,6 +255,7 @@ TEST(StereoFrontend, PixelShiftHintCentresTheTemporalSearch) {
   const double tx = 60.0;
   FrontendOptions opt;
   opt.search_radius = 30;
+  opt.predicted_search_radius = 30;
   for (const bool use_hint : {false, true}) {
     StereoFrontend fe;
     ASSERT_TRUE(fe.init(opt, syntheticCamera()).isOk());
@@ -328,7 +330,8 @@ class KittiFrontend : public ::testing::Test {
 bench::KittiOdometrySample* KittiFrontend::sample_ = nullptr;
 
 // Bounds are the values measured on these frames (see the printed summary) with a margin of
-// about 20 %.
+// about 20 %: measured min 597 stereo matches, min 342 circular matches, min share 0.55 of the
+// previous frame's features keeping their id, 395 ids seen in >= 5 of the 11 frames.
 TEST_F(KittiFrontend, MatchCountsDisparitiesAndTrackPersistence) {
   std::vector<FrameFeatures> frames;
   std::vector<FrontendStats> stats;
@@ -350,7 +353,7 @@ TEST_F(KittiFrontend, MatchCountsDisparitiesAndTrackPersistence) {
     if (k > 0) {
       EXPECT_GE(s.tracks_kept, 280) << "frame " << k;
       // Share of the previous frame's features that keep their id.
-      EXPECT_GE(static_cast<double>(s.tracks_kept) / s.tracks_in, 0.40) << "frame " << k;
+      EXPECT_GE(static_cast<double>(s.tracks_kept) / s.tracks_in, 0.45) << "frame " << k;
     }
     for (const auto& o : f.observations) {
       ASSERT_GT(o.disparity(), 0.0);
@@ -373,7 +376,8 @@ TEST_F(KittiFrontend, MatchCountsDisparitiesAndTrackPersistence) {
   std::printf("\n");
   int long_tracks = 0;
   for (const auto& [n, c] : histogram) long_tracks += (n >= 5) ? c : 0;
-  EXPECT_GE(long_tracks, 200);
+  std::printf("ids seen in >= 5 frames: %d\n", long_tracks);
+  EXPECT_GE(long_tracks, 320);
 }
 
 TEST_F(KittiFrontend, Deterministic) {

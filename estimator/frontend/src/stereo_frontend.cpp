@@ -192,6 +192,9 @@ Status FrontendOptions::validate() const {
   if (search_radius < 4 || search_radius > 1000) {
     return badKey("search_radius", "must be in [4, 1000] px");
   }
+  if (predicted_search_radius < 4 || predicted_search_radius > search_radius) {
+    return badKey("predicted_search_radius", "must be in [4, search_radius] px");
+  }
   if (max_sad < 1 || max_sad > 255 * StereoFrontend::kDescriptorBytes) {
     return badKey("max_sad", "must be in [1, 8160]");
   }
@@ -550,11 +553,10 @@ int StereoFrontend::matchRightToLeft(int ri) const {
 }
 
 int StereoFrontend::matchTemporal(const CandidateSet& from, int idx, const CandidateSet& to,
-                                  float shift_u, float shift_v) const {
+                                  float shift_u, float shift_v, int r) const {
   const Keypoint& kp = from.kp[static_cast<std::size_t>(idx)];
   const int cu = kp.u + static_cast<int>(std::lround(shift_u));
   const int cv = kp.v + static_cast<int>(std::lround(shift_v));
-  const int r = options_.search_radius;
   return searchWindow(to, from.desc.data() + static_cast<std::ptrdiff_t>(idx) * kDescriptorBytes,
                       kp.cls, cu - r, cu + r, cv - r, cv + r, nullptr);
 }
@@ -670,31 +672,40 @@ Status StereoFrontend::process(const cv::Mat& left, const cv::Mat& right, TimeNs
   const CandidateSet& lp = left_[prev];
   const CandidateSet& rp = right_[prev];
   const double tol2 = options_.circular_tolerance_px * options_.circular_tolerance_px;
-  for (const Track& tr : tracks_prev_) {
-    if (out.observations.size() >= max_out) break;
-    const int c = matchTemporal(rp, tr.right, rc, hint_du_, hint_dv_);
-    if (c < 0) {
-      ++stats_.lost_temporal;
-      continue;
-    }
+  // One trip around the circle with temporal windows of half size `radius` centred on the
+  // shift (su, sv); 0 and (c, d) on success, else 1 temporal, 2 stereo, 3 circle.
+  auto circle = [&](const Track& tr, float su, float sv, int radius, int* c_out, int* d_out) {
+    const int c = matchTemporal(rp, tr.right, rc, su, sv, radius);
+    if (c < 0) return 1;
     const int d = matchRightToLeft(c);
-    if (d < 0 || left_used_[static_cast<std::size_t>(d)] != 0) {
-      ++stats_.lost_stereo;
-      continue;
-    }
-    const int a2 = matchTemporal(lc, d, lp, -hint_du_, -hint_dv_);
-    if (a2 < 0) {
-      ++stats_.lost_circle;
-      continue;
-    }
+    if (d < 0 || left_used_[static_cast<std::size_t>(d)] != 0) return 2;
+    const int a2 = matchTemporal(lc, d, lp, -su, -sv, radius);
+    if (a2 < 0) return 3;
     const Keypoint& ka = lp.kp[static_cast<std::size_t>(tr.left)];
     const Keypoint& kb = lp.kp[static_cast<std::size_t>(a2)];
     const double eu = ka.u - kb.u;
     const double ev = ka.v - kb.v;
-    if (eu * eu + ev * ev > tol2) {
-      ++stats_.lost_circle;
-      continue;
+    if (eu * eu + ev * ev > tol2) return 3;
+    *c_out = c;
+    *d_out = d;
+    return 0;
+  };
+  for (const Track& tr : tracks_prev_) {
+    if (out.observations.size() >= max_out) break;
+    // First where the point would be if it kept its last image motion (a track seen in two
+    // frames), with the small radius; failing that (or without history) around the caller's
+    // hint with the full radius.
+    int c = -1;
+    int d = -1;
+    int result = 1;
+    if (tr.has_flow) {
+      result = circle(tr, tr.flow_u, tr.flow_v, options_.predicted_search_radius, &c, &d);
     }
+    if (result != 0) result = circle(tr, hint_du_, hint_dv_, options_.search_radius, &c, &d);
+    if (result == 1) ++stats_.lost_temporal;
+    if (result == 2) ++stats_.lost_stereo;
+    if (result == 3) ++stats_.lost_circle;
+    if (result != 0) continue;
     StereoObservation obs;
     if (!refineStereo(d, c, obs)) {
       ++stats_.lost_range;
@@ -703,7 +714,10 @@ Status StereoFrontend::process(const cv::Mat& left, const cv::Mat& right, TimeNs
     obs.landmark_id = tr.id;
     out.observations.push_back(obs);
     left_used_[static_cast<std::size_t>(d)] = 1;
-    tracks_cur_.push_back(Track{tr.id, d, c});
+    const Keypoint& ka = lp.kp[static_cast<std::size_t>(tr.left)];
+    const Keypoint& kd = lc.kp[static_cast<std::size_t>(d)];
+    tracks_cur_.push_back(
+        Track{tr.id, d, c, static_cast<float>(kd.u - ka.u), static_cast<float>(kd.v - ka.v), true});
     ++bucket_count_[static_cast<std::size_t>(bucketOf(obs.u_left, obs.v_left))];
   }
   stats_.tracks_kept = static_cast<int>(tracks_cur_.size());
@@ -761,7 +775,7 @@ Status StereoFrontend::process(const cv::Mat& left, const cv::Mat& right, TimeNs
       obs.landmark_id = next_id_++;
       out.observations.push_back(obs);
       left_used_[static_cast<std::size_t>(best)] = 1;
-      tracks_cur_.push_back(Track{obs.landmark_id, best, r});
+      tracks_cur_.push_back(Track{obs.landmark_id, best, r, 0.0F, 0.0F, false});
       ++filled;
       ++stats_.new_features;
     }

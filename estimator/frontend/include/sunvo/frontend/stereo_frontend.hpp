@@ -11,7 +11,9 @@
 //     on a 4x4 grid over 13x13 px around it; a grid index per image for window searches.
 //  2. Tracks: every feature output in the previous frame is followed around the circle
 //     prev-left -> prev-right -> cur-right -> cur-left -> prev-left; it keeps its id only if the
-//     circle closes within circular_tolerance_px.
+//     circle closes within circular_tolerance_px. A feature tracked before is first searched
+//     around the position predicted by its last image motion (small radius); otherwise, or if
+//     that circle does not close, around the pixel-shift hint with the full radius.
 //  3. New features: the strongest unused current-left candidates of each bucket (grid of buckets,
 //     at most max_per_bucket features per bucket including tracked ones) that have a left-right
 //     consistent stereo match; they get new ids.
@@ -52,6 +54,11 @@ struct FrontendOptions {
   double max_disparity = 250.0;        // px, (min_disparity, max_width): largest disparity
   int stereo_row_tolerance = 1;        // px, [0, 4]: |v_left - v_right| allowed for a candidate
   int search_radius = 100;             // px, [4, 1000]: half size of the square temporal window
+                                       //   for features without motion history (centred on the
+                                       //   pixel-shift hint)
+  int predicted_search_radius = 20;    // px, [4, search_radius]: the same for tracked features,
+                                       //   centred on the position predicted from their last
+                                       //   image motion (constant image velocity)
   int max_sad = 1200;                  // SAD of 32 uint8 samples, [1, 8160]: worse matches rejected
   double circular_tolerance_px = 1.5;  // px, [0, 100]: the circle must close this close
   int lr_tolerance = 1;                // px, [0, 10]: left->right->left check for new features
@@ -141,6 +148,9 @@ class StereoFrontend {
     std::int64_t id = -1;
     std::int32_t left = -1;   // candidate index in that frame's left set
     std::int32_t right = -1;  // candidate index in that frame's right set
+    float flow_u = 0.0F;      // px, left image motion over the frame before (if has_flow)
+    float flow_v = 0.0F;
+    bool has_flow = false;  // tracked over at least one frame pair
   };
   static constexpr int kCell = 16;         // px, grid index cell size
   static constexpr int kRefineRadius = 4;  // px, half size of the dense subpixel window
@@ -159,8 +169,10 @@ class StereoFrontend {
                    int v1, int* cost) const;
   int matchLeftToRight(int li, int* cost) const;
   int matchRightToLeft(int ri) const;
+  // Best candidate of `to` for candidate idx of `from` in the square window of half size r
+  // centred on the candidate's position + (shift_u, shift_v).
   int matchTemporal(const CandidateSet& from, int idx, const CandidateSet& to, float shift_u,
-                    float shift_v) const;
+                    float shift_v, int r) const;
   std::int64_t denseCost(int ul, int ur, int v) const;
   // Subpixel u of the right match ri of left candidate li (in the current frame); false if the
   // disparity falls outside the range.
