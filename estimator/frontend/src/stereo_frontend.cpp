@@ -397,61 +397,66 @@ void StereoFrontend::detect(const cv::Mat& img_in, int img_index, CandidateSet& 
     return equal == 0;
   };
 
-  // Only rows b-n .. h-b+n-1 feed the windows of candidate rows b .. h-b-1.
-  const std::ptrdiff_t first = static_cast<std::ptrdiff_t>(b - n) * stride_;
-  const std::ptrdiff_t total = static_cast<std::ptrdiff_t>(h - 2 * b + 2 * n) * stride_;
   const int x0 = b;
   const int x1 = w - b;  // exclusive
   std::uint8_t* flags = flag_row_.data();
-  for (int type = 0; type < 2; ++type) {
-    const std::int16_t* r = responses[type];
-    // (2n+1)^2 max and min: horizontal then vertical running max/min.
-    const std::array<std::int16_t*, 4> tmp = {nms_a_.data(), nms_b_.data(), nms_c_.data(),
-                                              nms_d_.data()};
-    windowMaxMin(r + first, r + first, nms_hmax_.data() + first, nms_hmin_.data() + first, tmp, 1,
-                 n, total);
-    windowMaxMin(nms_hmax_.data() + first, nms_hmin_.data() + first, nms_max_.data() + first,
-                 nms_min_.data() + first, tmp, stride_, n, total);
-    const int thr = thresholds[type];
-    const auto pos_thr = static_cast<std::int16_t>(thr);
-    const auto neg_thr = static_cast<std::int16_t>(-thr);
-    for (int y = b; y < h - b; ++y) {
-      const std::ptrdiff_t off = static_cast<std::ptrdiff_t>(y) * stride_;
-      const std::int16_t* row = r + off;
-      const std::int16_t* vmax = nms_max_.data() + off;
-      const std::int16_t* vmin = nms_min_.data() + off;
-      for (int x = x0; x < x1; ++x) {
-        const int is_max = (row[x] == vmax[x]) & (row[x] >= pos_thr);
-        const int is_min = (row[x] == vmin[x]) & (row[x] <= neg_thr);
-        flags[x] = static_cast<std::uint8_t>(is_max | (is_min << 1));
-      }
-      std::memset(flags + x1, 0, 8);  // so that the last 8-byte word reads no stale flags
-      // Visit the non-zero flag bytes, 8 at a time (little-endian: byte i = bits 8i .. 8i+7).
-      for (int xw = x0; xw < x1; xw += 8) {
-        std::uint64_t word = 0;
-        std::memcpy(&word, flags + xw, sizeof(word));
-        while (word != 0) {
-          const int byte = std::countr_zero(word) / 8;
-          word &= ~(std::uint64_t{0xFF} << (8 * byte));
-          const int x = xw + byte;
-          const int f = flags[x];
-          for (int sign = 1; sign >= -1; sign -= 2) {
-            if ((f & (sign > 0 ? 1 : 2)) == 0) continue;
-            if (!isFirstExtremum(r, x, y)) continue;
-            if (set.count >= options_.max_candidates) {
-              set.truncated = true;
-              continue;
+  const std::array<std::int16_t*, 4> tmp = {nms_a_.data(), nms_b_.data(), nms_c_.data(),
+                                            nms_d_.data()};
+  // Candidate rows b .. h-b-1 in strips of kNmsStrip rows, so that the filter passes of a strip
+  // (rows ys-n .. ye+n-1) stay in cache; within a strip type 0 then type 1, each row-major.
+  for (int ys = b; ys < h - b; ys += kNmsStrip) {
+    const int ye = std::min(ys + kNmsStrip, h - b);
+    const std::ptrdiff_t first = static_cast<std::ptrdiff_t>(ys - n) * stride_;
+    const std::ptrdiff_t total = static_cast<std::ptrdiff_t>(ye - ys + 2 * n) * stride_;
+    for (int type = 0; type < 2; ++type) {
+      const std::int16_t* r = responses[type];
+      // (2n+1)^2 max and min: horizontal then vertical running max/min.
+      windowMaxMin(r + first, r + first, nms_hmax_.data() + first, nms_hmin_.data() + first, tmp, 1,
+                   n, total);
+      windowMaxMin(nms_hmax_.data() + first, nms_hmin_.data() + first, nms_max_.data() + first,
+                   nms_min_.data() + first, tmp, stride_, n, total);
+      const int thr = thresholds[type];
+      const auto pos_thr = static_cast<std::int16_t>(thr);
+      const auto neg_thr = static_cast<std::int16_t>(-thr);
+      for (int y = ys; y < ye; ++y) {
+        const std::ptrdiff_t off = static_cast<std::ptrdiff_t>(y) * stride_;
+        const std::int16_t* row = r + off;
+        const std::int16_t* vmax = nms_max_.data() + off;
+        const std::int16_t* vmin = nms_min_.data() + off;
+        for (int x = x0; x < x1; ++x) {
+          const int is_max = (row[x] == vmax[x]) & (row[x] >= pos_thr);
+          const int is_min = (row[x] == vmin[x]) & (row[x] <= neg_thr);
+          flags[x] = static_cast<std::uint8_t>(is_max | (is_min << 1));
+        }
+        std::memset(flags + x1, 0, 8);  // so that the last 8-byte word reads no stale flags
+        // Visit the non-zero flag bytes, 8 at a time (little-endian: byte i = bits 8i .. 8i+7).
+        for (int xw = x0; xw < x1; xw += 8) {
+          std::uint64_t word = 0;
+          std::memcpy(&word, flags + xw, sizeof(word));
+          while (word != 0) {
+            const int byte = std::countr_zero(word) / 8;
+            word &= ~(std::uint64_t{0xFF} << (8 * byte));
+            const int x = xw + byte;
+            const int f = flags[x];
+            for (int sign = 1; sign >= -1; sign -= 2) {
+              if ((f & (sign > 0 ? 1 : 2)) == 0) continue;
+              if (!isFirstExtremum(r, x, y)) continue;
+              if (set.count >= options_.max_candidates) {
+                set.truncated = true;
+                continue;
+              }
+              Keypoint& kp = set.kp[static_cast<std::size_t>(set.count)];
+              kp.u = static_cast<std::int16_t>(x);
+              kp.v = static_cast<std::int16_t>(y);
+              kp.cls = static_cast<std::uint8_t>(2 * type + (sign > 0 ? 0 : 1));
+              kp.strength = sign * row[x];
+              kp.du = parabolaPeak(row[x - 1], row[x], row[x + 1]);
+              kp.dv = parabolaPeak(row[x - stride_], row[x], row[x + stride_]);
+              describeAt(
+                  img_index, x, y,
+                  set.desc.data() + static_cast<std::ptrdiff_t>(set.count) * kDescriptorBytes);
+              ++set.count;
             }
-            Keypoint& kp = set.kp[static_cast<std::size_t>(set.count)];
-            kp.u = static_cast<std::int16_t>(x);
-            kp.v = static_cast<std::int16_t>(y);
-            kp.cls = static_cast<std::uint8_t>(2 * type + (sign > 0 ? 0 : 1));
-            kp.strength = sign * row[x];
-            kp.du = parabolaPeak(row[x - 1], row[x], row[x + 1]);
-            kp.dv = parabolaPeak(row[x - stride_], row[x], row[x + stride_]);
-            describeAt(img_index, x, y,
-                       set.desc.data() + static_cast<std::ptrdiff_t>(set.count) * kDescriptorBytes);
-            ++set.count;
           }
         }
       }
