@@ -152,10 +152,9 @@ class StereoFrontend {
     float flow_v = 0.0F;
     bool has_flow = false;  // tracked over at least one frame pair
   };
-  static constexpr int kCell = 16;  // px, grid index cell size
-  static constexpr int kRefineRadius = 4;
-  static constexpr int kNmsStrip =
-      24;  // rows per NMS strip (cache blocking)  // px, half size of the dense subpixel window
+  static constexpr int kCell = 16;         // px, grid index cell size
+  static constexpr int kRefineRadius = 4;  // px, half size of the dense subpixel window
+  static constexpr int kNmsStrip = 24;     // rows per NMS strip (cache blocking)
   static constexpr int kClasses = 4;
 
   // img_index 0 = left, 1 = right: which gradient buffers are written / read.
