@@ -216,9 +216,10 @@ Status StereoFrontend::init(const FrontendOptions& options, const StereoCamera& 
   options_ = options;
   camera_ = camera;
   stride_ = options.max_width;
-  // Descriptors at the right match +-2 px reach kDescriptorReach + 2 + 1 (Sobel) px; the NMS
-  // window reaches nms_radius + 2 (response mask) px.
-  border_ = std::max(kDescriptorReach + 3, options.nms_radius + 2);
+  // From a candidate, reads reach: descriptor kDescriptorReach + 1 (Sobel) px; the subpixel
+  // window of the right match kRefineRadius + 2 (shift) + 1 (Sobel) px; the NMS window
+  // nms_radius + 2 (response mask) px. One pixel spare.
+  border_ = std::max({kDescriptorReach + 2, kRefineRadius + 4, options.nms_radius + 2});
 
   const auto pixels =
       static_cast<std::size_t>(options.max_width) * static_cast<std::size_t>(options.max_height);

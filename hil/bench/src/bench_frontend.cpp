@@ -39,6 +39,7 @@ struct Results {
   std::vector<double> detect_cpu_ms, temporal_cpu_ms, stereo_cpu_ms, total_cpu_ms;
   std::vector<double> features, tracked, candidates_left;
   std::vector<std::uint64_t> allocs;
+  std::uint64_t init_bytes = 0;  // heap bytes requested by StereoFrontend::init()
   long rss_warm_kb = 0;
   long rss_end_kb = 0;
   long hwm_end_kb = 0;
@@ -84,7 +85,9 @@ double percentile(std::vector<double> v, double q) {
 void benchFrontend(benchmark::State& state) {
   sunvo::StereoFrontend fe;
   sunvo::FrontendOptions opt;
+  const std::uint64_t bytes0 = sunvo::bench::allocatedBytes();
   const sunvo::Status st = fe.init(opt, g_sample.camera);
+  g_results.init_bytes = sunvo::bench::allocatedBytes() - bytes0;
   if (!st.isOk()) {
     state.SkipWithError(st.toString().c_str());
     return;
@@ -186,8 +189,11 @@ void printSummary() {
               static_cast<unsigned long long>(total), r.allocs.size(),
               static_cast<double>(total) / static_cast<double>(r.allocs.size()),
               static_cast<unsigned long long>(worst));
-  std::printf("RSS after warm-up %ld kB, at end %ld kB (peak %ld kB)\n", r.rss_warm_kb,
-              r.rss_end_kb, r.hwm_end_kb);
+  std::printf(
+      "RSS after warm-up %ld kB, at end %ld kB (peak %ld kB); front-end buffers "
+      "allocated in init(): %.1f MB\n",
+      r.rss_warm_kb, r.rss_end_kb, r.hwm_end_kb,
+      static_cast<double>(r.init_bytes) / (1024.0 * 1024.0));
   std::printf(
       "features/frame median %.0f (min %.0f), circular-tracked median %.0f (min %.0f), "
       "left candidates median %.0f\n",

@@ -23,7 +23,9 @@
 // Memory: every buffer is allocated in init() from the options (max image size, max candidates,
 // max features). process() performs no heap allocation once `out.observations` has capacity for
 // max_features (reserveOutput() does that; otherwise process() reserves it on its first call).
-// Deterministic: no randomness; ties are broken by candidate order (row-major scan).
+// Deterministic: no randomness; ties are broken by candidate order. Not thread-safe: one
+// instance per thread; process() is single-threaded and makes no OpenCV calls that could
+// start threads.
 
 #include <array>
 #include <cstdint>
