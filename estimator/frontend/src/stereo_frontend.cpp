@@ -230,9 +230,12 @@ Status StereoFrontend::init(const FrontendOptions& options, const StereoCamera& 
   smooth_.assign(pixels, 0);
   blob_.assign(pixels, 0);
   corner_.assign(pixels, 0);
+  const auto strip_pixels = static_cast<std::size_t>(options.max_width) *
+                            static_cast<std::size_t>(kNmsStrip + 2 * options.nms_radius);
   for (auto* buffer :
-       {&nms_a_, &nms_b_, &nms_c_, &nms_d_, &nms_hmax_, &nms_hmin_, &nms_max_, &nms_min_})
-    buffer->assign(pixels, 0);
+       {&nms_a_, &nms_b_, &nms_c_, &nms_d_, &nms_hmax_, &nms_hmin_, &nms_max_, &nms_min_}) {
+    buffer->assign(strip_pixels, 0);
+  }
   flag_row_.assign(static_cast<std::size_t>(options.max_width) + 8, 0);
 
   const auto max_cand = static_cast<std::size_t>(options.max_candidates);
@@ -412,18 +415,19 @@ void StereoFrontend::detect(const cv::Mat& img_in, int img_index, CandidateSet& 
     for (int type = 0; type < 2; ++type) {
       const std::int16_t* r = responses[type];
       // (2n+1)^2 max and min: horizontal then vertical running max/min.
-      windowMaxMin(r + first, r + first, nms_hmax_.data() + first, nms_hmin_.data() + first, tmp, 1,
-                   n, total);
-      windowMaxMin(nms_hmax_.data() + first, nms_hmin_.data() + first, nms_max_.data() + first,
-                   nms_min_.data() + first, tmp, stride_, n, total);
+      // The NMS buffers hold one strip: their row 0 is image row ys - n.
+      windowMaxMin(r + first, r + first, nms_hmax_.data(), nms_hmin_.data(), tmp, 1, n, total);
+      windowMaxMin(nms_hmax_.data(), nms_hmin_.data(), nms_max_.data(), nms_min_.data(), tmp,
+                   stride_, n, total);
       const int thr = thresholds[type];
       const auto pos_thr = static_cast<std::int16_t>(thr);
       const auto neg_thr = static_cast<std::int16_t>(-thr);
       for (int y = ys; y < ye; ++y) {
         const std::ptrdiff_t off = static_cast<std::ptrdiff_t>(y) * stride_;
         const std::int16_t* row = r + off;
-        const std::int16_t* vmax = nms_max_.data() + off;
-        const std::int16_t* vmin = nms_min_.data() + off;
+        const std::ptrdiff_t strip_off = off - first;
+        const std::int16_t* vmax = nms_max_.data() + strip_off;
+        const std::int16_t* vmin = nms_min_.data() + strip_off;
         for (int x = x0; x < x1; ++x) {
           const int is_max = (row[x] == vmax[x]) & (row[x] >= pos_thr);
           const int is_min = (row[x] == vmin[x]) & (row[x] <= neg_thr);
