@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 #include <string>
@@ -378,6 +379,49 @@ TEST_F(KittiFrontend, MatchCountsDisparitiesAndTrackPersistence) {
   for (const auto& [n, c] : histogram) long_tracks += (n >= 5) ? c : 0;
   std::printf("ids seen in >= 5 frames: %d\n", long_tracks);
   EXPECT_GE(long_tracks, 320);
+}
+
+// Geometric consistency of the tracks: the 3-D points triangulated in frame k and their
+// observations in frame k+1 must fit one rigid motion (OpenCV's PnP RANSAC, 2 px threshold,
+// fixed internal seed). The car drives straight ahead here at 0.68-0.86 m per frame (see
+// data/README.md), so the motion must be mostly forward with little rotation.
+TEST_F(KittiFrontend, TracksFitOneRigidMotion) {
+  std::vector<FrameFeatures> frames;
+  std::vector<FrontendStats> stats;
+  runAll(&frames, &stats);
+  const StereoCamera& cam = sample_->camera;
+  const cv::Matx33d K(cam.fu, 0.0, cam.cu, 0.0, cam.fv, cam.cv, 0.0, 0.0, 1.0);
+  for (std::size_t k = 0; k + 1 < frames.size(); ++k) {
+    const auto prev = byId(frames[k]);
+    std::vector<cv::Point3d> object;
+    std::vector<cv::Point2d> image;
+    for (const auto& o : frames[k + 1].observations) {
+      auto it = prev.find(o.landmark_id);
+      if (it == prev.end()) continue;
+      const Eigen::Vector3d p =
+          cam.triangulate(it->second.u_left, it->second.v_left, it->second.disparity());
+      object.emplace_back(p.x(), p.y(), p.z());
+      image.emplace_back(o.u_left, o.v_left);
+    }
+    ASSERT_GE(object.size(), 100u);
+    cv::Mat rvec, tvec;
+    std::vector<int> inliers;
+    ASSERT_TRUE(cv::solvePnPRansac(object, image, K, cv::noArray(), rvec, tvec, false, 500, 2.0,
+                                   0.999, inliers));
+    const double share = static_cast<double>(inliers.size()) / static_cast<double>(object.size());
+    const double angle_deg = cv::norm(rvec) * 180.0 / CV_PI;
+    const cv::Vec3d t(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2));
+    std::printf(
+        "frames %zu->%zu: %zu tracks, %.1f %% PnP inliers (2 px), rotation %.2f deg, "
+        "t = (%.3f, %.3f, %.3f) m\n",
+        k, k + 1, object.size(), 100.0 * share, angle_deg, t[0], t[1], t[2]);
+    EXPECT_GE(share, 0.80) << "frames " << k << "->" << k + 1;
+    EXPECT_LT(angle_deg, 2.0);
+    // p_{k+1} = R p_k + t: driving forward moves the points toward the camera, t_z < 0.
+    EXPECT_GT(-t[2], 0.5);
+    EXPECT_LT(-t[2], 1.1);
+    EXPECT_LT(std::hypot(t[0], t[1]), 0.2);
+  }
 }
 
 TEST_F(KittiFrontend, Deterministic) {
