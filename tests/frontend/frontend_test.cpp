@@ -424,6 +424,24 @@ TEST_F(KittiFrontend, TracksFitOneRigidMotion) {
   }
 }
 
+// The other KITTI image size (1242 x 375, the default maximum width) works as well.
+TEST_F(KittiFrontend, AcceptsTheOtherKittiImageSize) {
+  StereoFrontend fe;
+  ASSERT_TRUE(fe.init(FrontendOptions{}, sample_->camera).isOk());
+  FrameFeatures out;
+  for (std::size_t k = 0; k < 3; ++k) {
+    cv::Mat l, r;
+    cv::copyMakeBorder(sample_->left[k].rowRange(0, 375), l, 0, 0, 0, 1, cv::BORDER_REPLICATE);
+    cv::copyMakeBorder(sample_->right[k].rowRange(0, 375), r, 0, 0, 0, 1, cv::BORDER_REPLICATE);
+    ASSERT_EQ(l.cols, 1242);
+    ASSERT_TRUE(fe.process(l, r, 0, k, out).isOk());
+    EXPECT_GE(out.observations.size(), 500u);
+    if (k > 0) {
+      EXPECT_GE(fe.lastStats().tracks_kept, 280);
+    }
+  }
+}
+
 TEST_F(KittiFrontend, Deterministic) {
   std::vector<FrameFeatures> a, b;
   std::vector<FrontendStats> sa, sb;
