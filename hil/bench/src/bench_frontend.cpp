@@ -1,0 +1,254 @@
+// Front-end benchmark on real KITTI images: the 11 frames of 00_first_frames played forward and
+// backward (0..10..0..10..), single-threaded (cv::setNumThreads(0); the front end itself makes no
+// OpenCV calls that could spawn threads). Prints per-stage median/p95/p99, heap allocations per
+// frame inside process() after a warm-up, and the resident set size.
+//
+// Usage: sunvo_bench_frontend [--frames=N] [--warmup=N] [--data=DIR] [--cpu=K] [benchmark flags]
+//   --cpu=K pins the process to CPU K (sched_setaffinity) before anything runs.
+
+#include <benchmark/benchmark.h>
+#include <sched.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <ctime>
+#include <fstream>
+#include <opencv2/core/utility.hpp>
+#include <string>
+#include <vector>
+
+#include "sunvo/bench/alloc_counter.hpp"
+#include "sunvo/bench/kitti_sample.hpp"
+#include "sunvo/frontend/stereo_frontend.hpp"
+
+namespace {
+
+struct Config {
+  int frames = 500;
+  int warmup = 20;
+  std::string data = std::string(SUNVO_DATA_DIR) + "/kitti_odometry/00_first_frames";
+  int cpu = -1;  // pin to this CPU when >= 0
+};
+
+struct Results {
+  std::vector<double> detect_ms, temporal_ms, stereo_ms, total_ms;
+  std::vector<double> detect_cpu_ms, temporal_cpu_ms, stereo_cpu_ms, total_cpu_ms;
+  std::vector<double> features, tracked, candidates_left;
+  std::vector<std::uint64_t> allocs;
+  std::uint64_t init_bytes = 0;  // heap bytes requested by StereoFrontend::init()
+  long rss_warm_kb = 0;
+  long rss_end_kb = 0;
+  long hwm_end_kb = 0;
+  bool ok = false;
+};
+
+Config g_config;
+Results g_results;
+sunvo::bench::KittiOdometrySample g_sample;
+
+// "VmRSS:" or "VmHWM:" of /proc/self/status in kB; -1 if unreadable.
+long procStatusKb(const char* key) {
+  std::ifstream f("/proc/self/status");
+  std::string line;
+  const std::size_t n = std::strlen(key);
+  while (std::getline(f, line)) {
+    if (line.compare(0, n, key) == 0) return std::strtol(line.c_str() + n, nullptr, 10);
+  }
+  return -1;
+}
+
+// CPU time of this thread, ms.
+double threadCpuMs() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
+}
+
+// 0,1,..,10,9,..,1,0,1,.. for 11 frames.
+std::size_t pingPong(std::size_t i, std::size_t n) {
+  const std::size_t period = 2 * (n - 1);
+  const std::size_t k = i % period;
+  return k < n ? k : period - k;
+}
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const auto rank = static_cast<std::size_t>(std::ceil(q * static_cast<double>(v.size())));
+  return v[std::min(v.size() - 1, rank == 0 ? 0 : rank - 1)];
+}
+
+void benchFrontend(benchmark::State& state) {
+  sunvo::StereoFrontend fe;
+  sunvo::FrontendOptions opt;
+  const std::uint64_t bytes0 = sunvo::bench::allocatedBytes();
+  const sunvo::Status st = fe.init(opt, g_sample.camera);
+  g_results.init_bytes = sunvo::bench::allocatedBytes() - bytes0;
+  if (!st.isOk()) {
+    state.SkipWithError(st.toString().c_str());
+    return;
+  }
+  sunvo::FrameFeatures out;
+  fe.reserveOutput(out);
+  const std::size_t n = g_sample.left.size();
+  std::size_t frame = 0;
+  for (int i = 0; i < g_config.warmup; ++i, ++frame) {
+    const std::size_t k = pingPong(frame, n);
+    if (!fe.process(g_sample.left[k], g_sample.right[k], 0, frame, out).isOk()) {
+      state.SkipWithError("process failed in warm-up");
+      return;
+    }
+  }
+  Results& r = g_results;
+  const auto frames = static_cast<std::size_t>(g_config.frames);
+  for (auto* v : {&r.detect_ms, &r.temporal_ms, &r.stereo_ms, &r.total_ms, &r.detect_cpu_ms,
+                  &r.temporal_cpu_ms, &r.stereo_cpu_ms, &r.total_cpu_ms, &r.features, &r.tracked,
+                  &r.candidates_left}) {
+    v->clear();
+    v->reserve(frames);
+  }
+  r.allocs.clear();
+  r.allocs.reserve(frames);
+  r.rss_warm_kb = procStatusKb("VmRSS:");
+  bool failed = false;
+  for (auto _ : state) {
+    const std::size_t k = pingPong(frame, n);
+    const auto t0 = std::chrono::steady_clock::now();
+    const double cpu0 = threadCpuMs();
+    const std::uint64_t a0 = sunvo::bench::allocationCount();
+    const sunvo::Status s = fe.process(g_sample.left[k], g_sample.right[k], 0, frame, out);
+    const std::uint64_t a1 = sunvo::bench::allocationCount();
+    const double cpu1 = threadCpuMs();
+    const auto t1 = std::chrono::steady_clock::now();
+    if (!s.isOk()) failed = true;
+    const sunvo::FrontendStats& fs = fe.lastStats();
+    r.allocs.push_back(a1 - a0);
+    r.total_ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+    r.detect_ms.push_back(static_cast<double>(fs.detect_ns) * 1e-6);
+    r.temporal_ms.push_back(static_cast<double>(fs.temporal_ns) * 1e-6);
+    r.stereo_ms.push_back(static_cast<double>(fs.stereo_ns) * 1e-6);
+    r.total_cpu_ms.push_back(cpu1 - cpu0);
+    r.detect_cpu_ms.push_back(static_cast<double>(fs.detect_cpu_ns) * 1e-6);
+    r.temporal_cpu_ms.push_back(static_cast<double>(fs.temporal_cpu_ns) * 1e-6);
+    r.stereo_cpu_ms.push_back(static_cast<double>(fs.stereo_cpu_ns) * 1e-6);
+    r.features.push_back(static_cast<double>(out.observations.size()));
+    r.tracked.push_back(static_cast<double>(fs.tracks_kept));
+    r.candidates_left.push_back(static_cast<double>(fs.candidates_left));
+    ++frame;
+  }
+  r.rss_end_kb = procStatusKb("VmRSS:");
+  r.hwm_end_kb = procStatusKb("VmHWM:");
+  if (failed) {
+    state.SkipWithError("process failed");
+    return;
+  }
+  std::uint64_t total_allocs = 0;
+  for (auto a : r.allocs) total_allocs += a;
+  state.counters["allocs_per_frame"] =
+      static_cast<double>(total_allocs) / static_cast<double>(r.allocs.size());
+  state.counters["features"] = percentile(r.features, 0.5);
+  state.counters["tracked"] = percentile(r.tracked, 0.5);
+  state.counters["cpu_ms_p50"] = percentile(r.total_cpu_ms, 0.5);
+  state.counters["detect_ms_p50"] = percentile(r.detect_ms, 0.5);
+  state.counters["temporal_ms_p50"] = percentile(r.temporal_ms, 0.5);
+  state.counters["stereo_ms_p50"] = percentile(r.stereo_ms, 0.5);
+  r.ok = true;
+}
+
+void printSummary() {
+  const Results& r = g_results;
+  if (!r.ok) return;
+  std::printf(
+      "\nfront end on %zu frames of %dx%d (00_first_frames ping-pong), after %d warm-up "
+      "frames, single thread (cv::setNumThreads(0))\n",
+      r.total_ms.size(), g_sample.camera.width, g_sample.camera.height, g_config.warmup);
+  std::printf("%-32s %9s %9s %9s %9s\n", "stage [ms]", "median", "p95", "p99", "max");
+  auto row = [](const char* name, const std::vector<double>& v) {
+    std::printf("%-32s %9.3f %9.3f %9.3f %9.3f\n", name, percentile(v, 0.5), percentile(v, 0.95),
+                percentile(v, 0.99), percentile(v, 1.0));
+  };
+  row("wall: detect (both images)", r.detect_ms);
+  row("wall: temporal + circular", r.temporal_ms);
+  row("wall: stereo match (new)", r.stereo_ms);
+  row("wall: process() total", r.total_ms);
+  row("cpu:  detect (both images)", r.detect_cpu_ms);
+  row("cpu:  temporal + circular", r.temporal_cpu_ms);
+  row("cpu:  stereo match (new)", r.stereo_cpu_ms);
+  row("cpu:  process() total", r.total_cpu_ms);
+  std::uint64_t total = 0;
+  std::uint64_t worst = 0;
+  for (auto a : r.allocs) {
+    total += a;
+    worst = std::max(worst, a);
+  }
+  std::printf("heap allocations in process(): %llu in %zu frames (%.3f per frame, max %llu)\n",
+              static_cast<unsigned long long>(total), r.allocs.size(),
+              static_cast<double>(total) / static_cast<double>(r.allocs.size()),
+              static_cast<unsigned long long>(worst));
+  std::printf(
+      "RSS after warm-up %ld kB, at end %ld kB (peak %ld kB); front-end buffers "
+      "allocated in init(): %.1f MB\n",
+      r.rss_warm_kb, r.rss_end_kb, r.hwm_end_kb,
+      static_cast<double>(r.init_bytes) / (1024.0 * 1024.0));
+  std::printf(
+      "features/frame median %.0f (min %.0f), circular-tracked median %.0f (min %.0f), "
+      "left candidates median %.0f\n",
+      percentile(r.features, 0.5), percentile(r.features, 0.0), percentile(r.tracked, 0.5),
+      percentile(r.tracked, 0.0), percentile(r.candidates_left, 0.5));
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  cv::setNumThreads(0);
+  // Own flags first; the rest goes to Google Benchmark.
+  std::vector<char*> rest;
+  for (int i = 0; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a.rfind("--frames=", 0) == 0) {
+      g_config.frames = std::max(1, std::atoi(a.c_str() + 9));
+    } else if (a.rfind("--warmup=", 0) == 0) {
+      g_config.warmup = std::max(0, std::atoi(a.c_str() + 9));
+    } else if (a.rfind("--cpu=", 0) == 0) {
+      g_config.cpu = std::atoi(a.c_str() + 6);
+    } else if (a.rfind("--data=", 0) == 0) {
+      g_config.data = a.substr(7);
+    } else {
+      rest.push_back(argv[i]);
+    }
+  }
+  if (g_config.cpu >= 0) {
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    CPU_SET(g_config.cpu, &set);
+    if (sched_setaffinity(0, sizeof(set), &set) != 0) {
+      std::fprintf(stderr, "cannot pin to CPU %d\n", g_config.cpu);
+      return 1;
+    }
+    std::printf("pinned to CPU %d\n", g_config.cpu);
+  }
+  if (!sunvo::bench::allocCounterActive()) {
+    std::fprintf(stderr, "allocation counter is not active in this binary\n");
+    return 1;
+  }
+  auto sample = sunvo::bench::loadKittiOdometrySample(g_config.data);
+  if (!sample) {
+    std::fprintf(stderr, "%s\n", sample.status().toString().c_str());
+    return 1;
+  }
+  g_sample = std::move(*sample);
+  benchmark::RegisterBenchmark("frontend/kitti00_first_frames_pingpong", benchFrontend)
+      ->Iterations(g_config.frames)
+      ->Unit(benchmark::kMillisecond)
+      ->UseRealTime();
+  int rest_argc = static_cast<int>(rest.size());
+  benchmark::Initialize(&rest_argc, rest.data());
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  printSummary();
+  return g_results.ok ? 0 : 1;
+}
