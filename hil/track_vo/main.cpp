@@ -5,7 +5,7 @@
 // Usage: sunvo_track_vo <track_folder> <out_poses.txt> [--frames N] [--window N] [--no-window]
 //          [--sigma-uv px] [--sigma-d px] [--loss none|huber|cauchy] [--loss-scale s]
 //          [--ransac-thr px] [--ransac-iters n] [--min-inliers n] [--max-iters n]
-//          [--max-time s] [--min-disparity px] [--seed n]
+//          [--max-time s] [--min-disparity px] [--seed n] [--log per_frame.csv]
 
 #include <algorithm>
 #include <chrono>
@@ -38,7 +38,7 @@ int usage(const char* msg) {
                "usage: sunvo_track_vo <track_folder> <out_poses.txt> [--frames N] [--window N] "
                "[--no-window] [--sigma-uv px] [--sigma-d px] [--loss none|huber|cauchy] "
                "[--loss-scale s] [--ransac-thr px] [--ransac-iters n] [--min-inliers n] "
-               "[--max-iters n] [--max-time s] [--min-disparity px] [--seed n]\n");
+               "[--max-iters n] [--max-time s] [--min-disparity px] [--seed n] [--log per_frame.csv]\n");
   return 2;
 }
 
@@ -50,6 +50,7 @@ int main(int argc, char** argv) {
   const std::string out_path = argv[2];
   sunvo::vo::VoOptions opt;
   long max_frames = -1;
+  std::string log_path;
   for (int i = 3; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&](double& v) {
@@ -59,7 +60,10 @@ int main(int argc, char** argv) {
       return end != nullptr && *end == '\0';
     };
     double v = 0.0;
-    if (a == "--no-window") {
+    if (a == "--log") {
+      if (i + 1 >= argc) return usage("--log needs a path");
+      log_path = argv[++i];
+    } else if (a == "--no-window") {
       opt.use_window = false;
     } else if (a == "--loss") {
       if (i + 1 >= argc) return usage("--loss needs a value");
@@ -119,6 +123,11 @@ int main(int argc, char** argv) {
   }
   std::vector<Isometry3> poses;
   poses.reserve(n);
+  std::FILE* log = log_path.empty() ? nullptr : std::fopen(log_path.c_str(), "w");
+  if (log != nullptr) {
+    std::fprintf(log, "frame,status,matches,ransac_inliers,window_landmarks,window_residuals,"
+                      "solver_iterations,window_used,ransac_ms,window_ms,reference_gap\n");
+  }
   std::vector<double> total_ms, ransac_ms, window_ms;
   int lost = 0, recovered = 0, window_fallbacks = 0;
   long iterations = 0;
@@ -132,6 +141,11 @@ int main(int argc, char** argv) {
       return 1;
     }
     poses.push_back(r->T_w_c);
+    if (log != nullptr) {
+      std::fprintf(log, "%zu,%s,%d,%d,%d,%d,%d,%d,%.4f,%.4f,%d\n", k, sunvo::vo::toString(r->status),
+                   r->num_matches, r->ransac_inliers, r->window_landmarks, r->window_residuals,
+                   r->solver_iterations, r->window_used ? 1 : 0, r->ransac_ms, r->window_ms, r->reference_gap);
+    }
     if (k == 0) continue;
     total_ms.push_back(ms);
     ransac_ms.push_back(r->ransac_ms);
@@ -143,6 +157,7 @@ int main(int argc, char** argv) {
     }
     iterations += r->solver_iterations;
   }
+  if (log != nullptr) std::fclose(log);
   if (auto s = sunvo::files::writeKittiPoses(out_path, poses); !s.isOk()) {
     std::fprintf(stderr, "sunvo_track_vo: %s\n", s.toString().c_str());
     return 1;

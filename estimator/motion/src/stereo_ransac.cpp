@@ -60,40 +60,66 @@ bool StereoRansac::reprojectionError(const Isometry3& T_k_km1, const Eigen::Vect
   return true;
 }
 
-// Gauss-Newton on r_i(T) = h(T p_i) - y_i with h the stereo projection above. Perturbation on the
-// left: T <- (exp(phi) , rho) T, so to first order p' = T p + rho + phi x (T p) and
-//   d p' / d(rho, phi) = [ I  | -[p']_x ].
-// Jacobian of h at p' = (x, y, z):
+// Jacobian of the stereo projection h(p) = (fu x/z + cu, fv y/z + cv, fu (x-b)/z + cu) at p:
 //   du/dp  = fu [1/z, 0, -x/z^2],  dv/dp = fv [0, 1/z, -y/z^2],
 //   dur/dp = fu [1/z, 0, -(x-b)/z^2].
+// Returns false when p is not in front of the camera.
+static bool projectWithJacobian(const StereoCamera& c, const Eigen::Vector3d& p,
+                                Eigen::Vector3d& h, Eigen::Matrix3d& Jh) {
+  if (!(p.z() > kMinDepth)) return false;
+  const double iz = 1.0 / p.z();
+  const double iz2 = iz * iz;
+  h << c.fu * p.x() * iz + c.cu, c.fv * p.y() * iz + c.cv,
+      c.fu * (p.x() - c.baseline_m) * iz + c.cu;
+  Jh << c.fu * iz, 0.0, -c.fu * p.x() * iz2,  //
+      0.0, c.fv * iz, -c.fv * p.y() * iz2,    //
+      c.fu * iz, 0.0, -c.fu * (p.x() - c.baseline_m) * iz2;
+  return true;
+}
+
+static Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d S;
+  S << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
+  return S;
+}
+
+// Gauss-Newton on the symmetric ("circular") stereo reprojection error of the matches in idx:
+//   forward   r_f = h(T p_prev) - y_cur,      backward  r_b = h(T^-1 p_cur) - y_prev,
+// with p_prev, p_cur triangulated in their own frames. Using both directions removes most of
+// the bias that the noisy depth of far points puts into a one-directional fit.
+// Perturbation on the left: T <- (exp(phi), rho) T, so to first order
+//   T p_prev      -> T p_prev + rho + phi x (T p_prev):  d/d(rho, phi) = [ I | -[T p_prev]_x ]
+//   T^-1 p_cur    -> C^T (p_cur - rho - phi x p_cur - t): d/d(rho, phi) = [ -C^T | C^T [p_cur]_x ]
 // Normal equations (J^T J) delta = -J^T r (6x6, fixed size, LDLT); update
 //   C <- exp(phi) C,  t <- exp(phi) t + rho.
 bool StereoRansac::refine(Isometry3& T, std::span<const int> idx, int iterations) const {
   for (int it = 0; it < iterations; ++it) {
     Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
     Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
+    const Eigen::Matrix3d Ct = T.linear().transpose();
+    const Isometry3 T_inv = T.inverse();
     for (int i : idx) {
       const auto ui = static_cast<std::size_t>(i);
-      const Eigen::Vector3d p = T * p_prev_[ui];
-      if (!(p.z() > kMinDepth)) continue;
       const StereoMatch& m = matches_[ui];
-      const double iz = 1.0 / p.z();
-      const double iz2 = iz * iz;
-      Eigen::Vector3d r;
-      r.x() = camera_.fu * p.x() * iz + camera_.cu - m.u_cur;
-      r.y() = camera_.fv * p.y() * iz + camera_.cv - m.v_cur;
-      r.z() = camera_.fu * (p.x() - camera_.baseline_m) * iz + camera_.cu - m.ur_cur;
+      Eigen::Vector3d h;
       Eigen::Matrix3d Jh;
-      Jh << camera_.fu * iz, 0.0, -camera_.fu * p.x() * iz2,  //
-          0.0, camera_.fv * iz, -camera_.fv * p.y() * iz2,    //
-          camera_.fu * iz, 0.0, -camera_.fu * (p.x() - camera_.baseline_m) * iz2;
-      Eigen::Matrix3d P;  // -[p]_x
-      P << 0.0, p.z(), -p.y(), -p.z(), 0.0, p.x(), p.y(), -p.x(), 0.0;
       Eigen::Matrix<double, 3, 6> J;
-      J.leftCols<3>() = Jh;
-      J.rightCols<3>() = Jh * P;
-      H.noalias() += J.transpose() * J;
-      g.noalias() += J.transpose() * r;
+      const Eigen::Vector3d pf = T * p_prev_[ui];
+      if (projectWithJacobian(camera_, pf, h, Jh)) {
+        const Eigen::Vector3d r = h - Eigen::Vector3d(m.u_cur, m.v_cur, m.ur_cur);
+        J.leftCols<3>() = Jh;
+        J.rightCols<3>() = -Jh * skew(pf);
+        H.noalias() += J.transpose() * J;
+        g.noalias() += J.transpose() * r;
+      }
+      const Eigen::Vector3d pb = T_inv * p_cur_[ui];
+      if (projectWithJacobian(camera_, pb, h, Jh)) {
+        const Eigen::Vector3d r = h - Eigen::Vector3d(m.u_prev, m.v_prev, m.ur_prev);
+        J.leftCols<3>() = -Jh * Ct;
+        J.rightCols<3>() = Jh * Ct * skew(p_cur_[ui]);
+        H.noalias() += J.transpose() * J;
+        g.noalias() += J.transpose() * r;
+      }
     }
     const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt(H);
     if (ldlt.info() != Eigen::Success) return false;
@@ -111,6 +137,7 @@ int StereoRansac::score(const Isometry3& T, std::vector<std::uint8_t>& mask, dou
   const double thr2 = options_.inlier_threshold_px * options_.inlier_threshold_px;
   int count = 0;
   sq_sum = 0.0;
+  const Isometry3 T_inv = T.inverse();
   std::fill(mask.begin(), mask.begin() + static_cast<std::ptrdiff_t>(matches_.size()), 0);
   for (int k = 0; k < n_usable_; ++k) {
     const int i = usable_[static_cast<std::size_t>(k)];
@@ -118,7 +145,13 @@ int StereoRansac::score(const Isometry3& T, std::vector<std::uint8_t>& mask, dou
     Eigen::Vector3d e;
     if (!reprojectionError(T, p_prev_[ui], matches_[ui], e)) continue;
     const double e2 = e.squaredNorm();
-    if (e2 <= thr2) {
+    // Backward check: p_cur moved into k-1 against the k-1 measurement.
+    const Eigen::Vector3d pb = T_inv * p_cur_[ui];
+    if (!(pb.z() > kMinDepth)) continue;
+    const StereoMatch& m = matches_[ui];
+    const Eigen::Vector3d hb = camera_.project(pb);
+    const Eigen::Vector3d eb(hb.x() - m.u_prev, hb.y() - m.v_prev, hb.x() - hb.z() - m.ur_prev);
+    if (e2 <= thr2 && eb.squaredNorm() <= thr2) {
       mask[ui] = 1;
       ++count;
       sq_sum += e2;

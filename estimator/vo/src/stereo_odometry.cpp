@@ -61,124 +61,140 @@ Status StereoOdometry::init(const VoOptions& options, const StereoCamera& camera
   SUNVO_RETURN_IF_ERROR(ransac_.init(options.ransac, camera));
   if (options.use_window) SUNVO_RETURN_IF_ERROR(window_.init(options.window, camera));
   const auto n = static_cast<std::size_t>(options.max_observations);
-  prev_obs_.assign(n, StereoObservation{});
-  prev_sorted_.assign(n, IdIndex{});
+  for (RefFrame* ref : {&good_, &lost_frame_}) {
+    ref->obs.assign(n, StereoObservation{});
+    ref->sorted.assign(n, IdIndex{});
+    ref->count = 0;
+    ref->valid = false;
+  }
   matches_.assign(n, motion::StereoMatch{});
   match_cur_index_.assign(n, 0);
   window_obs_.assign(n, backend::WindowObservation{});
-  prev_count_ = 0;
   T_w_c0_ = T_w_c0;
-  T_w_prev_ = T_w_c0;
+  T_w_last_ = T_w_c0;
   last_motion_ = Isometry3::Identity();
-  have_prev_ = false;
   lost_ = false;
   initialized_ = true;
   return Status::ok();
 }
 
-void StereoOdometry::rememberFrame(const FrameFeatures& frame) {
-  prev_count_ = static_cast<int>(frame.observations.size());
-  for (int i = 0; i < prev_count_; ++i) {
+void StereoOdometry::store(RefFrame& ref, const FrameFeatures& frame, const Isometry3& T_w_c) {
+  ref.count = static_cast<int>(frame.observations.size());
+  for (int i = 0; i < ref.count; ++i) {
     const auto ui = static_cast<std::size_t>(i);
-    prev_obs_[ui] = frame.observations[ui];
-    prev_sorted_[ui] = IdIndex{frame.observations[ui].landmark_id, i};
+    ref.obs[ui] = frame.observations[ui];
+    ref.sorted[ui] = IdIndex{frame.observations[ui].landmark_id, i};
   }
-  std::sort(prev_sorted_.begin(), prev_sorted_.begin() + prev_count_,
+  std::sort(ref.sorted.begin(), ref.sorted.begin() + ref.count,
             [](const IdIndex& a, const IdIndex& b) { return a.id < b.id; });
-  have_prev_ = true;
+  ref.sequence = frame.sequence;
+  ref.time_ns = frame.time_ns;
+  ref.T_w_c = T_w_c;
+  ref.valid = true;
 }
 
-// Restarts the window at this frame: every observation with positive disparity goes in.
-static int baseObservations(const FrameFeatures& frame,
-                            std::vector<backend::WindowObservation>& out) {
+// Association by landmark id (binary search in the reference's sorted ids); fills matches_ and
+// match_cur_index_ (increasing current-frame indices).
+int StereoOdometry::associate(const RefFrame& ref, const FrameFeatures& frame) {
   int n = 0;
-  for (const auto& o : frame.observations) {
-    if (!(o.disparity() > 0.0)) continue;
-    out[static_cast<std::size_t>(n++)] = {o.landmark_id, {o.u_left, o.v_left, o.disparity()}};
+  const auto sorted_end = ref.sorted.begin() + ref.count;
+  for (std::size_t i = 0; i < frame.observations.size(); ++i) {
+    const StereoObservation& o = frame.observations[i];
+    const auto it = std::lower_bound(ref.sorted.begin(), sorted_end, o.landmark_id,
+                                     [](const IdIndex& a, std::int64_t id) { return a.id < id; });
+    if (it == sorted_end || it->id != o.landmark_id) continue;
+    const StereoObservation& p = ref.obs[static_cast<std::size_t>(it->index)];
+    const auto m = static_cast<std::size_t>(n++);
+    matches_[m] = {p.u_left, p.v_left, p.u_right, o.u_left, o.v_left, o.u_right};
+    match_cur_index_[m] = static_cast<int>(i);
   }
   return n;
 }
 
-VoResult StereoOdometry::lose(const FrameFeatures& frame, VoResult r) {
-  const Isometry3 motion =
-      options_.constant_velocity_on_loss ? last_motion_ : Isometry3::Identity();
-  r.T_k_km1 = motion;
-  r.T_w_c = T_w_prev_ * motion.inverse();
-  r.status = TrackingStatus::kLost;
-  r.window_used = false;
-  T_w_prev_ = r.T_w_c;
-  if (options_.use_window) {
-    window_.reset(r.T_w_c);
-    const int n = baseObservations(frame, window_obs_);
-    // Cannot fail: sizes were checked by process().
-    (void)window_.addFrame(frame.sequence, frame.time_ns,
-                           std::span(window_obs_.data(), static_cast<std::size_t>(n)),
-                           Isometry3::Identity());
+// Window observations of a frame that starts a window: every one with positive disparity.
+int StereoOdometry::baseObservations(const RefFrame& ref) {
+  int n = 0;
+  for (int i = 0; i < ref.count; ++i) {
+    const StereoObservation& o = ref.obs[static_cast<std::size_t>(i)];
+    if (!(o.disparity() > 0.0)) continue;
+    window_obs_[static_cast<std::size_t>(n++)] = {o.landmark_id,
+                                                  {o.u_left, o.v_left, o.disparity()}};
   }
-  rememberFrame(frame);
-  lost_ = true;
-  return r;
+  return n;
+}
+
+Status StereoOdometry::restartWindowAt(const RefFrame& ref) {
+  if (!options_.use_window) return Status::ok();
+  window_.reset(ref.T_w_c);
+  const int n = baseObservations(ref);
+  return window_.addFrame(ref.sequence, ref.time_ns,
+                          std::span(window_obs_.data(), static_cast<std::size_t>(n)),
+                          Isometry3::Identity());
 }
 
 Expected<VoResult> StereoOdometry::process(const FrameFeatures& frame) {
   if (!initialized_) return failedPrecondition("StereoOdometry::process before init");
   if (frame.observations.size() > static_cast<std::size_t>(options_.max_observations)) {
-    return invalidArgument(
-        "vo: frame " + std::to_string(frame.sequence) + " has " +
-        std::to_string(frame.observations.size()) +
-        " observations > vo.max_observations = " + std::to_string(options_.max_observations));
+    return invalidArgument("vo: frame " + std::to_string(frame.sequence) + " has " +
+                           std::to_string(frame.observations.size()) +
+                           " observations > vo.max_observations = " +
+                           std::to_string(options_.max_observations));
   }
   VoResult r;
   r.sequence = frame.sequence;
   r.time_ns = frame.time_ns;
 
-  if (!have_prev_) {
+  if (!good_.valid) {
     r.T_w_c = T_w_c0_;
     r.status = TrackingStatus::kInitializing;
-    T_w_prev_ = T_w_c0_;
-    if (options_.use_window) {
-      window_.reset(T_w_c0_);
-      const int n = baseObservations(frame, window_obs_);
-      SUNVO_RETURN_IF_ERROR(window_.addFrame(
-          frame.sequence, frame.time_ns, std::span(window_obs_.data(), static_cast<std::size_t>(n)),
-          Isometry3::Identity()));
-    }
-    rememberFrame(frame);
+    T_w_last_ = T_w_c0_;
+    store(good_, frame, T_w_c0_);
+    SUNVO_RETURN_IF_ERROR(restartWindowAt(good_));
     return r;
   }
 
-  // Association with frame k-1 by landmark id (binary search in the sorted previous ids).
+  // RANSAC against the last good frame, then (after a loss) against the most recent lost frame.
   const auto t_ransac = std::chrono::steady_clock::now();
+  const RefFrame* ref = nullptr;
+  motion::MotionEstimate est;
   int n_matches = 0;
-  const auto sorted_end = prev_sorted_.begin() + prev_count_;
-  for (std::size_t i = 0; i < frame.observations.size(); ++i) {
-    const StereoObservation& o = frame.observations[i];
-    const auto it = std::lower_bound(prev_sorted_.begin(), sorted_end, o.landmark_id,
-                                     [](const IdIndex& a, std::int64_t id) { return a.id < id; });
-    if (it == sorted_end || it->id != o.landmark_id) continue;
-    const StereoObservation& p = prev_obs_[static_cast<std::size_t>(it->index)];
-    const auto m = static_cast<std::size_t>(n_matches++);
-    matches_[m] = {p.u_left, p.v_left, p.u_right, o.u_left, o.v_left, o.u_right};
-    match_cur_index_[m] = static_cast<int>(i);
+  for (const RefFrame* candidate : {&good_, &lost_frame_}) {
+    if (!candidate->valid) continue;
+    n_matches = associate(*candidate, frame);
+    auto e = ransac_.estimate(std::span(matches_.data(), static_cast<std::size_t>(n_matches)),
+                              mixSeed(options_.seed ^ frame.sequence));
+    if (e && e->T_k_km1.translation().norm() <=
+                 options_.max_translation_per_frame_m *
+                     static_cast<double>(frame.sequence - candidate->sequence)) {
+      est = *e;
+      ref = candidate;
+      break;
+    }
   }
   r.num_matches = n_matches;
-  auto est = ransac_.estimate(std::span(matches_.data(), static_cast<std::size_t>(n_matches)),
-                              mixSeed(options_.seed ^ frame.sequence));
   r.ransac_ms = msSince(t_ransac);
-  if (!est || est->T_k_km1.translation().norm() > options_.max_translation_per_frame_m) {
-    return lose(frame, r);
+
+  if (ref == nullptr) {
+    // Lost: predict, remember this frame as the most recent lost one, keep good_ and the window.
+    const Isometry3 motion =
+        options_.constant_velocity_on_loss ? last_motion_ : Isometry3::Identity();
+    r.T_k_km1 = motion;
+    r.T_w_c = T_w_last_ * motion.inverse();
+    r.status = TrackingStatus::kLost;
+    T_w_last_ = r.T_w_c;
+    store(lost_frame_, frame, r.T_w_c);
+    lost_ = true;
+    return r;
   }
-  r.ransac_inliers = est->num_inliers;
-  r.T_k_km1 = est->T_k_km1;
-  Isometry3 T_w_k = T_w_prev_ * est->T_k_km1.inverse();
+  r.ransac_inliers = est.num_inliers;
+  r.reference_gap = static_cast<int>(frame.sequence - ref->sequence);
+  Isometry3 T_w_k = ref->T_w_c * est.T_k_km1.inverse();
 
   if (options_.use_window) {
     const auto t_window = std::chrono::steady_clock::now();
+    if (ref == &lost_frame_) SUNVO_RETURN_IF_ERROR(restartWindowAt(lost_frame_));
     // Window observations of frame k: RANSAC inliers among the matched, plus every unmatched
     // observation with positive disparity (new landmarks for the next windows).
-    std::fill(window_obs_.begin(),
-              window_obs_.begin() + static_cast<std::ptrdiff_t>(frame.observations.size()),
-              backend::WindowObservation{});
     int n = 0;
     int m = 0;
     for (std::size_t i = 0; i < frame.observations.size(); ++i) {
@@ -187,22 +203,23 @@ Expected<VoResult> StereoOdometry::process(const FrameFeatures& frame) {
       bool inlier = false;
       if (m < n_matches && match_cur_index_[static_cast<std::size_t>(m)] == static_cast<int>(i)) {
         matched = true;
-        inlier = est->inlier_mask[static_cast<std::size_t>(m)] != 0;
+        inlier = est.inlier_mask[static_cast<std::size_t>(m)] != 0;
         ++m;
       }
       if (matched ? !inlier : !(o.disparity() > 0.0)) continue;
       window_obs_[static_cast<std::size_t>(n++)] = {o.landmark_id,
                                                     {o.u_left, o.v_left, o.disparity()}};
     }
-    SUNVO_RETURN_IF_ERROR(
-        window_.addFrame(frame.sequence, frame.time_ns,
-                         std::span(window_obs_.data(), static_cast<std::size_t>(n)), est->T_k_km1));
+    SUNVO_RETURN_IF_ERROR(window_.addFrame(
+        frame.sequence, frame.time_ns, std::span(window_obs_.data(), static_cast<std::size_t>(n)),
+        est.T_k_km1));
     auto sol = window_.solve();
     if (sol) {
       const Isometry3 T_w_new = window_.T_w_newest();
-      const Isometry3 motion = T_w_new.inverse() * T_w_prev_;
-      if (allFinite(T_w_new) &&
-          motion.translation().norm() <= options_.max_translation_per_frame_m) {
+      const Isometry3 motion = T_w_new.inverse() * ref->T_w_c;
+      if (allFinite(T_w_new) && motion.translation().norm() <=
+                                    options_.max_translation_per_frame_m *
+                                        static_cast<double>(r.reference_gap)) {
         T_w_k = T_w_new;
         r.window_used = true;
       } else {
@@ -216,15 +233,16 @@ Expected<VoResult> StereoOdometry::process(const FrameFeatures& frame) {
     if (!r.window_used) T_w_k = window_.T_w_newest();  // the RANSAC guess chained in the window
     r.window_ms = msSince(t_window);
   }
-  if (!allFinite(T_w_k)) return lose(frame, r);
+  if (!allFinite(T_w_k)) T_w_k = ref->T_w_c * est.T_k_km1.inverse();
 
-  r.T_k_km1 = T_w_k.inverse() * T_w_prev_;
+  r.T_k_km1 = T_w_k.inverse() * T_w_last_;
   r.T_w_c = T_w_k;
   r.status = lost_ ? TrackingStatus::kRecovered : TrackingStatus::kTracking;
+  if (r.reference_gap == 1) last_motion_ = T_w_k.inverse() * ref->T_w_c;
   lost_ = false;
-  last_motion_ = r.T_k_km1;
-  T_w_prev_ = T_w_k;
-  rememberFrame(frame);
+  lost_frame_.valid = false;
+  T_w_last_ = T_w_k;
+  store(good_, frame, T_w_k);
   return r;
 }
 

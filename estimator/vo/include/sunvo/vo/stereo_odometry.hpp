@@ -9,8 +9,10 @@
 // Degenerate input (no or too few matches, all points at infinity / zero disparity, too few
 // inliers, a non-finite or implausible result) never yields NaN: the frame is reported kLost, its
 // pose is predicted with the last good inter-frame motion (constant velocity, or identity when
-// VoOptions::constant_velocity_on_loss is false), the window restarts at that frame, and the next
-// good frame is reported kRecovered. Zero motion between two good frames is not degenerate for a
+// VoOptions::constant_velocity_on_loss is false). The next frame is matched first with the last
+// well-tracked frame (the lost frame's pose was only a prediction, and real tracks persist across
+// a bad frame), then with the lost frame (the window then restarts there); the first frame that
+// tracks again is reported kRecovered. Zero motion between two good frames is not degenerate for a
 // stereo camera (depth is measured): it is tracked and gives T_k_km1 = identity.
 
 #include <cstdint>
@@ -57,6 +59,8 @@ struct VoResult {
   double ransac_ms = 0.0;      // wall time of association + RANSAC, ms
   double window_ms = 0.0;      // wall time of window update + solve, ms
   bool window_used = false;    // false when the RANSAC motion was kept (solver failure)
+  int reference_gap = 0;  // frames from the motion reference (1 = previous frame; > 1 = a lost
+                          // frame was bridged; 0 = none)
 };
 
 class StereoOdometry {
@@ -72,23 +76,36 @@ class StereoOdometry {
     std::int64_t id;
     int index;
   };
-  VoResult lose(const FrameFeatures& frame, VoResult r);
-  void rememberFrame(const FrameFeatures& frame);
+  // A frame kept as a motion reference: its observations (sorted ids for association) and pose.
+  struct RefFrame {
+    std::vector<StereoObservation> obs;  // capacity max_observations
+    std::vector<IdIndex> sorted;
+    int count = 0;
+    std::uint64_t sequence = 0;
+    TimeNs time_ns = 0;
+    Isometry3 T_w_c = Isometry3::Identity();
+    bool valid = false;
+  };
+  void store(RefFrame& ref, const FrameFeatures& frame, const Isometry3& T_w_c);
+  int associate(const RefFrame& ref, const FrameFeatures& frame);
+  int baseObservations(const RefFrame& ref);
+  Status restartWindowAt(const RefFrame& ref);
 
   VoOptions options_;
   StereoCamera camera_;
   motion::StereoRansac ransac_;
   backend::BundleWindow window_;
   bool initialized_ = false;
-  bool have_prev_ = false;
   bool lost_ = false;
   Isometry3 T_w_c0_ = Isometry3::Identity();
-  Isometry3 T_w_prev_ = Isometry3::Identity();
-  Isometry3 last_motion_ = Isometry3::Identity();  // T_k_km1 of the last good frame
+  Isometry3 T_w_last_ = Isometry3::Identity();     // pose emitted for the previous frame
+  Isometry3 last_motion_ = Isometry3::Identity();  // T_k_km1 of the last good consecutive pair
+  // The last well-tracked frame (the window's newest frame) and the most recent lost frame.
+  // After a loss the next frame is matched with `good_` first (bridging the lost frame, whose
+  // pose was only predicted), then with `lost_frame_`.
+  RefFrame good_;
+  RefFrame lost_frame_;
   // Buffers sized by max_observations.
-  std::vector<StereoObservation> prev_obs_;
-  int prev_count_ = 0;
-  std::vector<IdIndex> prev_sorted_;
   std::vector<motion::StereoMatch> matches_;
   std::vector<int> match_cur_index_;
   std::vector<backend::WindowObservation> window_obs_;
