@@ -34,11 +34,12 @@ double percentile(std::vector<double> v, double p) {
 
 int usage(const char* msg) {
   std::fprintf(stderr, "sunvo_track_vo: %s\n", msg);
-  std::fprintf(stderr,
-               "usage: sunvo_track_vo <track_folder> <out_poses.txt> [--frames N] [--window N] "
-               "[--no-window] [--sigma-uv px] [--sigma-d px] [--loss none|huber|cauchy] "
-               "[--loss-scale s] [--ransac-thr px] [--ransac-iters n] [--min-inliers n] "
-               "[--max-iters n] [--max-time s] [--min-disparity px] [--seed n] [--log per_frame.csv]\n");
+  std::fprintf(
+      stderr,
+      "usage: sunvo_track_vo <track_folder> <out_poses.txt> [--frames N] [--window N] "
+      "[--no-window] [--sigma-uv px] [--sigma-d px] [--loss none|huber|cauchy] "
+      "[--loss-scale s] [--ransac-thr px] [--ransac-iters n] [--min-inliers n] "
+      "[--max-iters n] [--max-time s] [--min-disparity px] [--seed n] [--log per_frame.csv]\n");
   return 2;
 }
 
@@ -125,8 +126,9 @@ int main(int argc, char** argv) {
   poses.reserve(n);
   std::FILE* log = log_path.empty() ? nullptr : std::fopen(log_path.c_str(), "w");
   if (log != nullptr) {
-    std::fprintf(log, "frame,status,matches,ransac_inliers,window_landmarks,window_residuals,"
-                      "solver_iterations,window_used,ransac_ms,window_ms,reference_gap\n");
+    std::fprintf(log,
+                 "frame,status,matches,ransac_inliers,window_landmarks,window_residuals,"
+                 "solver_iterations,window_used,ransac_ms,window_ms,reference_gap\n");
   }
   std::vector<double> total_ms, ransac_ms, window_ms;
   int lost = 0, recovered = 0, window_fallbacks = 0;
@@ -142,9 +144,10 @@ int main(int argc, char** argv) {
     }
     poses.push_back(r->T_w_c);
     if (log != nullptr) {
-      std::fprintf(log, "%zu,%s,%d,%d,%d,%d,%d,%d,%.4f,%.4f,%d\n", k, sunvo::vo::toString(r->status),
-                   r->num_matches, r->ransac_inliers, r->window_landmarks, r->window_residuals,
-                   r->solver_iterations, r->window_used ? 1 : 0, r->ransac_ms, r->window_ms, r->reference_gap);
+      std::fprintf(log, "%zu,%s,%d,%d,%d,%d,%d,%d,%.4f,%.4f,%d\n", k,
+                   sunvo::vo::toString(r->status), r->num_matches, r->ransac_inliers,
+                   r->window_landmarks, r->window_residuals, r->solver_iterations,
+                   r->window_used ? 1 : 0, r->ransac_ms, r->window_ms, r->reference_gap);
     }
     if (k == 0) continue;
     total_ms.push_back(ms);

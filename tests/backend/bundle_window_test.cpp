@@ -33,7 +33,8 @@ TEST(StereoResidual, AutodiffMatchesCentralDifferences) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   int checked = 0;
   for (int trial = 0; trial < 50; ++trial) {
-    const Eigen::Quaterniond q = Eigen::Quaterniond(expSO3(0.5 * Eigen::Vector3d(u(rng), u(rng), u(rng))));
+    const Eigen::Quaterniond q =
+        Eigen::Quaterniond(expSO3(0.5 * Eigen::Vector3d(u(rng), u(rng), u(rng))));
     double qa[4] = {q.x(), q.y(), q.z(), q.w()};
     double t[3] = {2.0 * u(rng), 2.0 * u(rng), 2.0 * u(rng)};
     // A landmark 4..40 m in front of camera k, expressed in b.
@@ -94,7 +95,8 @@ TEST(StereoResidual, BehindTheCameraIsLargeAndFinite) {
 // Builds window observations for frame k from a synthetic frame.
 std::vector<WindowObservation> toWindow(const FrameFeatures& f) {
   std::vector<WindowObservation> out;
-  for (const auto& o : f.observations) out.push_back({o.landmark_id, {o.u_left, o.v_left, o.disparity()}});
+  for (const auto& o : f.observations)
+    out.push_back({o.landmark_id, {o.u_left, o.v_left, o.disparity()}});
   return out;
 }
 
@@ -158,8 +160,8 @@ TEST(BundleWindow, RecoversMotionNoiseFree) {
   for (int n : {2, 3, 5}) {
     double rot = 0, trans = 0, pos = 0;
     runWindow(n, 1e-3, &rot, &trans, &pos);
-    std::printf("window %d, no noise: worst rot %.6f deg, worst trans %.6f %%, final pos %.6f m\n", n,
-                rot, 100 * trans, pos);
+    std::printf("window %d, no noise: worst rot %.6f deg, worst trans %.6f %%, final pos %.6f m\n",
+                n, rot, 100 * trans, pos);
     EXPECT_LT(rot, 1e-3) << "window " << n;
     EXPECT_LT(trans, 1e-3) << "window " << n;
   }
@@ -173,9 +175,10 @@ TEST(BundleWindow, RecoversMotionWithOnePixelNoise) {
   for (int n : {2, 4}) {
     double rot = 0, trans = 0, pos = 0, rms_rot = 0, rms_trans = 0;
     runWindow(n, 1.0, &rot, &trans, &pos, &rms_rot, &rms_trans);
-    std::printf("window %d, 1 px noise: rms rot %.4f deg, rms trans %.3f %%, worst rot %.4f deg, "
-                "worst trans %.3f %%, final pos %.4f m\n",
-                n, rms_rot, 100 * rms_trans, rot, 100 * trans, pos);
+    std::printf(
+        "window %d, 1 px noise: rms rot %.4f deg, rms trans %.3f %%, worst rot %.4f deg, "
+        "worst trans %.3f %%, final pos %.4f m\n",
+        n, rms_rot, 100 * rms_trans, rot, 100 * trans, pos);
     EXPECT_LT(rms_rot, 0.05) << "window " << n;
     EXPECT_LT(rms_trans, 0.02) << "window " << n;
     EXPECT_LT(rot, 0.08) << "window " << n;

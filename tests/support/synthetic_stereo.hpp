@@ -36,9 +36,9 @@ inline Isometry3 forwardMotion(double forward_m, double yaw_deg, double pitch_de
 
 struct SceneOptions {
   int num_landmarks = 3000;
-  double pixel_noise_px = 1.0;     // std of Gaussian noise on uL, vL, uR
-  double outlier_fraction = 0.0;   // fraction of observations per frame replaced by garbage
-  int max_per_frame = 150;         // observations kept per frame (the nearest-id first)
+  double pixel_noise_px = 1.0;    // std of Gaussian noise on uL, vL, uR
+  double outlier_fraction = 0.0;  // fraction of observations per frame replaced by garbage
+  int max_per_frame = 150;        // observations kept per frame (the nearest-id first)
   double max_depth_m = 60.0;
   std::uint64_t seed = 1;
 };

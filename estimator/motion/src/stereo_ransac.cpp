@@ -64,8 +64,8 @@ bool StereoRansac::reprojectionError(const Isometry3& T_k_km1, const Eigen::Vect
 //   du/dp  = fu [1/z, 0, -x/z^2],  dv/dp = fv [0, 1/z, -y/z^2],
 //   dur/dp = fu [1/z, 0, -(x-b)/z^2].
 // Returns false when p is not in front of the camera.
-static bool projectWithJacobian(const StereoCamera& c, const Eigen::Vector3d& p,
-                                Eigen::Vector3d& h, Eigen::Matrix3d& Jh) {
+static bool projectWithJacobian(const StereoCamera& c, const Eigen::Vector3d& p, Eigen::Vector3d& h,
+                                Eigen::Matrix3d& Jh) {
   if (!(p.z() > kMinDepth)) return false;
   const double iz = 1.0 / p.z();
   const double iz2 = iz * iz;

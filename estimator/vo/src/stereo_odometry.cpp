@@ -135,10 +135,10 @@ Status StereoOdometry::restartWindowAt(const RefFrame& ref) {
 Expected<VoResult> StereoOdometry::process(const FrameFeatures& frame) {
   if (!initialized_) return failedPrecondition("StereoOdometry::process before init");
   if (frame.observations.size() > static_cast<std::size_t>(options_.max_observations)) {
-    return invalidArgument("vo: frame " + std::to_string(frame.sequence) + " has " +
-                           std::to_string(frame.observations.size()) +
-                           " observations > vo.max_observations = " +
-                           std::to_string(options_.max_observations));
+    return invalidArgument(
+        "vo: frame " + std::to_string(frame.sequence) + " has " +
+        std::to_string(frame.observations.size()) +
+        " observations > vo.max_observations = " + std::to_string(options_.max_observations));
   }
   VoResult r;
   r.sequence = frame.sequence;
@@ -210,16 +210,16 @@ Expected<VoResult> StereoOdometry::process(const FrameFeatures& frame) {
       window_obs_[static_cast<std::size_t>(n++)] = {o.landmark_id,
                                                     {o.u_left, o.v_left, o.disparity()}};
     }
-    SUNVO_RETURN_IF_ERROR(window_.addFrame(
-        frame.sequence, frame.time_ns, std::span(window_obs_.data(), static_cast<std::size_t>(n)),
-        est.T_k_km1));
+    SUNVO_RETURN_IF_ERROR(
+        window_.addFrame(frame.sequence, frame.time_ns,
+                         std::span(window_obs_.data(), static_cast<std::size_t>(n)), est.T_k_km1));
     auto sol = window_.solve();
     if (sol) {
       const Isometry3 T_w_new = window_.T_w_newest();
       const Isometry3 motion = T_w_new.inverse() * ref->T_w_c;
-      if (allFinite(T_w_new) && motion.translation().norm() <=
-                                    options_.max_translation_per_frame_m *
-                                        static_cast<double>(r.reference_gap)) {
+      if (allFinite(T_w_new) &&
+          motion.translation().norm() <=
+              options_.max_translation_per_frame_m * static_cast<double>(r.reference_gap)) {
         T_w_k = T_w_new;
         r.window_used = true;
       } else {

@@ -59,8 +59,8 @@ struct VoResult {
   double ransac_ms = 0.0;      // wall time of association + RANSAC, ms
   double window_ms = 0.0;      // wall time of window update + solve, ms
   bool window_used = false;    // false when the RANSAC motion was kept (solver failure)
-  int reference_gap = 0;  // frames from the motion reference (1 = previous frame; > 1 = a lost
-                          // frame was bridged; 0 = none)
+  int reference_gap = 0;       // frames from the motion reference (1 = previous frame; > 1 = a lost
+                               // frame was bridged; 0 = none)
 };
 
 class StereoOdometry {
