@@ -5,7 +5,8 @@
 // Usage: sunvo_track_vo <track_folder> <out_poses.txt> [--frames N] [--window N] [--no-window]
 //          [--sigma-uv px] [--sigma-d px] [--loss none|huber|cauchy] [--loss-scale s]
 //          [--ransac-thr px] [--ransac-iters n] [--min-inliers n] [--max-iters n]
-//          [--max-time s] [--min-disparity px] [--seed n] [--log per_frame.csv]
+//          [--max-time s] [--min-disparity px] [--seed n] [--prior-rot-deg s] [--prior-trans-m s]
+//          [--log per_frame.csv]
 
 #include <algorithm>
 #include <chrono>
@@ -34,12 +35,12 @@ double percentile(std::vector<double> v, double p) {
 
 int usage(const char* msg) {
   std::fprintf(stderr, "sunvo_track_vo: %s\n", msg);
-  std::fprintf(
-      stderr,
-      "usage: sunvo_track_vo <track_folder> <out_poses.txt> [--frames N] [--window N] "
-      "[--no-window] [--sigma-uv px] [--sigma-d px] [--loss none|huber|cauchy] "
-      "[--loss-scale s] [--ransac-thr px] [--ransac-iters n] [--min-inliers n] "
-      "[--max-iters n] [--max-time s] [--min-disparity px] [--seed n] [--log per_frame.csv]\n");
+  std::fprintf(stderr,
+               "usage: sunvo_track_vo <track_folder> <out_poses.txt> [--frames N] [--window N] "
+               "[--no-window] [--sigma-uv px] [--sigma-d px] [--loss none|huber|cauchy] "
+               "[--loss-scale s] [--ransac-thr px] [--ransac-iters n] [--min-inliers n] "
+               "[--max-iters n] [--max-time s] [--min-disparity px] [--seed n] [--prior-rot-deg s] "
+               "[--prior-trans-m s] [--log per_frame.csv]\n");
   return 2;
 }
 
@@ -101,6 +102,10 @@ int main(int argc, char** argv) {
       opt.window.max_solver_time_in_seconds = v;
     } else if (a == "--min-disparity") {
       opt.ransac.min_disparity_px = opt.window.min_disparity_px = v;
+    } else if (a == "--prior-rot-deg") {
+      opt.window.motion_prior_sigma_rot_deg = v;
+    } else if (a == "--prior-trans-m") {
+      opt.window.motion_prior_sigma_trans_m = v;
     } else if (a == "--seed") {
       opt.seed = static_cast<std::uint64_t>(v);
     } else {

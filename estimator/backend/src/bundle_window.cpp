@@ -28,6 +28,17 @@ Status WindowOptions::validate() const {
   if (!(max_solver_time_in_seconds > 0.0)) {
     return invalidArgument("window.max_solver_time_in_seconds must be > 0");
   }
+  if (!(motion_prior_sigma_rot_deg >= 0.0)) {
+    return invalidArgument("window.motion_prior_sigma_rot_deg must be >= 0");
+  }
+  if (!(motion_prior_sigma_trans_m >= 0.0)) {
+    return invalidArgument("window.motion_prior_sigma_trans_m must be >= 0");
+  }
+  if ((motion_prior_sigma_rot_deg > 0.0) != (motion_prior_sigma_trans_m > 0.0)) {
+    return invalidArgument(
+        "window.motion_prior_sigma_rot_deg and window.motion_prior_sigma_trans_m must both be > 0 "
+        "or both 0");
+  }
   return Status::ok();
 }
 
@@ -67,7 +78,11 @@ Status BundleWindow::init(const WindowOptions& options, const StereoCamera& came
   for (std::size_t i = 0; i < n_pool; ++i) {
     cost_pool_.emplace_back(StereoResidual::Create(&measurements_[i], &model_));
   }
-  residual_ids_.assign(n_pool + 8 * kMaxWindowSize, nullptr);
+  for (std::size_t s = 0; s < frames_.size(); ++s) {
+    frames_[s].has_prior = false;
+    prior_pool_[s].reset(MotionPriorResidual::Create(&frames_[s].prior));
+  }
+  residual_ids_.assign(n_pool + 9 * kMaxWindowSize, nullptr);
   num_residuals_ = 0;
 
   switch (options.loss) {
@@ -132,7 +147,7 @@ Isometry3 BundleWindow::T_w_newest() const {
 
 Status BundleWindow::addFrame(std::uint64_t sequence, TimeNs time_ns,
                               std::span<const WindowObservation> obs,
-                              const Isometry3& T_k_km1_guess) {
+                              const Isometry3& T_k_km1_guess, const Isometry3* motion_prior) {
   if (!initialized_) return failedPrecondition("BundleWindow::addFrame before init");
   if (obs.size() > static_cast<std::size_t>(options_.max_observations_per_frame)) {
     return invalidArgument("window: " + std::to_string(obs.size()) +
@@ -162,6 +177,18 @@ Status BundleWindow::addFrame(std::uint64_t sequence, TimeNs time_ns,
   f.time_ns = time_ns;
   std::copy(obs.begin(), obs.end(), f.obs.begin());
   f.num_obs = static_cast<int>(obs.size());
+  f.has_prior = slot > 0 && motion_prior != nullptr && options_.motion_prior_sigma_rot_deg > 0.0 &&
+                allFinite(*motion_prior);
+  if (f.has_prior) {
+    const Eigen::Quaterniond q(motion_prior->linear());
+    f.prior.q_pred[0] = q.x();
+    f.prior.q_pred[1] = q.y();
+    f.prior.q_pred[2] = q.z();
+    f.prior.q_pred[3] = q.w();
+    for (int i = 0; i < 3; ++i) f.prior.t_pred[i] = motion_prior->translation()[i];
+    f.prior.sqrt_info_rot = 1.0 / (options_.motion_prior_sigma_rot_deg * M_PI / 180.0);
+    f.prior.sqrt_info_trans = 1.0 / options_.motion_prior_sigma_trans_m;
+  }
   if (slot == 0) {
     poses_[0] = PoseBlock{};
   } else {
@@ -260,6 +287,17 @@ Expected<WindowSolveSummary> BundleWindow::solve() {
   if (n_landmarks < 3) {
     return failedPrecondition("window: only " + std::to_string(n_landmarks) +
                               " landmarks seen in two or more frames");
+  }
+
+  // Motion priors between consecutive slots (the base frame's own prior refers to a frame that
+  // has left the window and is skipped).
+  for (int s = 1; s < size_; ++s) {
+    const auto us = static_cast<std::size_t>(s);
+    if (!frames_[us].has_prior) continue;
+    residual_ids_[static_cast<std::size_t>(num_residuals_++)] = problem_->AddResidualBlock(
+        prior_pool_[us].get(), nullptr, poses_[us - 1].q.data(), poses_[us - 1].t.data(),
+        poses_[us].q.data(), poses_[us].t.data());
+    ++out.num_prior_residuals;
   }
 
   saved_poses_ = poses_;

@@ -73,6 +73,7 @@ Status StereoOdometry::init(const VoOptions& options, const StereoCamera& camera
   T_w_c0_ = T_w_c0;
   T_w_last_ = T_w_c0;
   last_motion_ = Isometry3::Identity();
+  have_motion_ = false;
   lost_ = false;
   initialized_ = true;
   return Status::ok();
@@ -210,9 +211,11 @@ Expected<VoResult> StereoOdometry::process(const FrameFeatures& frame) {
       window_obs_[static_cast<std::size_t>(n++)] = {o.landmark_id,
                                                     {o.u_left, o.v_left, o.disparity()}};
     }
-    SUNVO_RETURN_IF_ERROR(
-        window_.addFrame(frame.sequence, frame.time_ns,
-                         std::span(window_obs_.data(), static_cast<std::size_t>(n)), est.T_k_km1));
+    // Constant-velocity prior: only between consecutive, well-tracked frames.
+    const bool use_prior = ref == &good_ && r.reference_gap == 1 && have_motion_;
+    SUNVO_RETURN_IF_ERROR(window_.addFrame(
+        frame.sequence, frame.time_ns, std::span(window_obs_.data(), static_cast<std::size_t>(n)),
+        est.T_k_km1, use_prior ? &last_motion_ : nullptr));
     auto sol = window_.solve();
     if (sol) {
       const Isometry3 T_w_new = window_.T_w_newest();
@@ -238,7 +241,10 @@ Expected<VoResult> StereoOdometry::process(const FrameFeatures& frame) {
   r.T_k_km1 = T_w_k.inverse() * T_w_last_;
   r.T_w_c = T_w_k;
   r.status = lost_ ? TrackingStatus::kRecovered : TrackingStatus::kTracking;
-  if (r.reference_gap == 1) last_motion_ = T_w_k.inverse() * ref->T_w_c;
+  if (r.reference_gap == 1) {
+    last_motion_ = T_w_k.inverse() * ref->T_w_c;
+    have_motion_ = true;
+  }
   lost_ = false;
   lost_frame_.valid = false;
   T_w_last_ = T_w_k;

@@ -52,7 +52,12 @@ struct WindowOptions {
   double loss_scale = 2.0;                // whitened units (sigmas), > 0: Huber/Cauchy scale
   double min_disparity_px = 1.0;  // px, > 0: smallest disparity used to triangulate a landmark
   int max_num_iterations = 10;    // count, [1, 1000]: Ceres iterations per solve
-  double max_solver_time_in_seconds = 0.05;  // s, > 0: Ceres time limit per solve
+  double max_solver_time_in_seconds = 0.05;
+  // Soft prior on each frame's motion relative to the previous window frame, when addFrame() is
+  // given a predicted motion (e.g. constant velocity). 0 disables it.
+  double motion_prior_sigma_rot_deg = 0.0;  // deg, >= 0: std of the rotation deviation
+  double motion_prior_sigma_trans_m =
+      0.0;  // m, >= 0: std of the translation deviation  // s, > 0: Ceres time limit per solve
 
   Status validate() const;
 };
@@ -66,6 +71,7 @@ struct WindowObservation {
 struct WindowSolveSummary {
   int num_landmarks = 0;
   int num_stereo_residuals = 0;
+  int num_prior_residuals = 0;
   int num_extra_residuals = 0;
   int iterations = 0;
   double solver_time_s = 0.0;
@@ -92,8 +98,9 @@ class BundleWindow {
   // ignored for the first frame after reset(). When the window is full the oldest frame leaves and
   // the next one becomes the base, its T_w_b chained from the current estimate.
   // Fails (kInvalidArgument) when observations exceed max_observations_per_frame.
+  // motion_prior (optional): a predicted T_k_km1 used as a soft prior when the options enable it.
   Status addFrame(std::uint64_t sequence, TimeNs time_ns, std::span<const WindowObservation> obs,
-                  const Isometry3& T_k_km1_guess);
+                  const Isometry3& T_k_km1_guess, const Isometry3* motion_prior = nullptr);
 
   // Builds the problem from the current frames and solves it. On a solver failure or a non-finite
   // result the poses keep their initial guesses and an error is returned.
@@ -129,6 +136,8 @@ class BundleWindow {
     TimeNs time_ns = 0;
     std::vector<WindowObservation> obs;  // capacity max_observations_per_frame
     int num_obs = 0;
+    bool has_prior = false;
+    MotionPriorData prior;  // relative to the previous slot
   };
   struct PoseBlock {
     std::array<double, 4> q{0.0, 0.0, 0.0, 1.0};  // q_k_b, Eigen order x y z w
@@ -156,6 +165,7 @@ class BundleWindow {
   std::vector<Entry> entries_;                    // window_size * max_observations_per_frame
   std::vector<StereoMeasurement> measurements_;   // one per stereo cost function
   std::vector<std::unique_ptr<ceres::CostFunction>> cost_pool_;
+  std::array<std::unique_ptr<ceres::CostFunction>, kMaxWindowSize> prior_pool_;
   std::vector<ceres::ResidualBlockId> residual_ids_;
   int num_residuals_ = 0;
   std::unique_ptr<ceres::LossFunction> loss_;

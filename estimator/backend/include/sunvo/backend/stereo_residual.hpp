@@ -79,4 +79,53 @@ class StereoResidual {
   const StereoModel* model_;
 };
 
+// A predicted relative motion between consecutive window frames (e.g. constant velocity).
+struct MotionPriorData {
+  double q_pred[4] = {0.0, 0.0, 0.0, 1.0};  // C_k_km1 predicted, Eigen order x y z w
+  double t_pred[3] = {0.0, 0.0, 0.0};       // t_k_km1 predicted, m
+  double sqrt_info_rot = 1.0;               // 1/rad
+  double sqrt_info_trans = 1.0;             // 1/m
+};
+
+// Soft prior on the relative motion of slots km1 and k (both expressed in the base b):
+//   T_k_km1 = T_k_b T_km1_b^-1:  C = C_k_b C_km1_b^T,  t = t_k_b - C t_km1_b.
+// Rotation error: dq = q_pred^-1 * q(C); for a small error dq = (sin(a/2) n, cos(a/2)) so
+// 2 vec(dq) = a n, the rotation vector (sign chosen so that dq.w >= 0). Translation error
+// t - t_pred. Residual r = (2 vec(dq) / sigma_rot, (t - t_pred) / sigma_trans).
+class MotionPriorResidual {
+ public:
+  explicit MotionPriorResidual(const MotionPriorData* prior) : prior_(prior) {}
+
+  template <typename T>
+  bool operator()(const T* q_km1_b, const T* t_km1_b, const T* q_k_b, const T* t_k_b,
+                  T* residual) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> q_km1(q_km1_b);
+    const Eigen::Map<const Eigen::Quaternion<T>> q_k(q_k_b);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t_km1(t_km1_b);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t_k(t_k_b);
+    const Eigen::Quaternion<T> q_rel = q_k * q_km1.conjugate();
+    const Eigen::Matrix<T, 3, 1> t_rel = t_k - q_rel * t_km1;
+    const Eigen::Quaternion<T> q_pred(T(prior_->q_pred[3]), T(prior_->q_pred[0]),
+                                      T(prior_->q_pred[1]), T(prior_->q_pred[2]));
+    Eigen::Quaternion<T> dq = q_pred.conjugate() * q_rel;
+    const T sign = dq.w() < T(0.0) ? T(-1.0) : T(1.0);
+    const T sr = T(2.0 * prior_->sqrt_info_rot) * sign;
+    residual[0] = sr * dq.x();
+    residual[1] = sr * dq.y();
+    residual[2] = sr * dq.z();
+    for (int i = 0; i < 3; ++i) {
+      residual[3 + i] = T(prior_->sqrt_info_trans) * (t_rel[i] - T(prior_->t_pred[i]));
+    }
+    return true;
+  }
+
+  static ceres::CostFunction* Create(const MotionPriorData* prior) {
+    return new ceres::AutoDiffCostFunction<MotionPriorResidual, 6, 4, 3, 4, 3>(
+        new MotionPriorResidual(prior));
+  }
+
+ private:
+  const MotionPriorData* prior_;
+};
+
 }  // namespace sunvo::backend

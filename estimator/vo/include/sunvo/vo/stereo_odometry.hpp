@@ -97,6 +97,7 @@ class StereoOdometry {
   backend::BundleWindow window_;
   bool initialized_ = false;
   bool lost_ = false;
+  bool have_motion_ = false;  // last_motion_ was measured (not the initial identity)
   Isometry3 T_w_c0_ = Isometry3::Identity();
   Isometry3 T_w_last_ = Isometry3::Identity();     // pose emitted for the previous frame
   Isometry3 last_motion_ = Isometry3::Identity();  // T_k_km1 of the last good consecutive pair
