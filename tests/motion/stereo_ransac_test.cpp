@@ -2,7 +2,27 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <cstdlib>
+#include <new>
+
 #include "../support/synthetic_stereo.hpp"
+
+// GCC 12 flags free() on memory from a replaced operator new although the pair is consistent.
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
+// Counts heap allocations of this test binary (to check that estimate() does not allocate).
+static std::atomic<long> g_allocations{0};
+void* operator new(std::size_t n) {
+  ++g_allocations;
+  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept {
+  std::free(p);
+}
+void operator delete(void* p, std::size_t) noexcept {
+  std::free(p);
+}
 
 namespace sunvo::motion {
 namespace {
@@ -147,6 +167,22 @@ TEST(StereoRansac, ZeroMotionIsIdentity) {
   EXPECT_LT(testing::rotationErrorDeg(e->T_k_km1, Isometry3::Identity()), 1e-6);
   EXPECT_LT(e->T_k_km1.translation().norm(), 1e-6);
   EXPECT_EQ(e->num_inliers, static_cast<int>(m.size()));
+}
+
+TEST(StereoRansac, NoHeapAllocationPerCallAfterInit) {
+  testing::SceneOptions o;
+  o.outlier_fraction = 0.3;
+  const auto m = makeMatches(forwardMotion(1.0, 1.0), o);
+  RansacOptions ro;
+  ro.inlier_threshold_px = 6.0;
+  StereoRansac r;
+  ASSERT_TRUE(r.init(ro, kittiCamera()).isOk());
+  const long before = g_allocations.load();
+  for (std::uint64_t seed = 0; seed < 20; ++seed) {
+    auto e = r.estimate(m, seed);
+    ASSERT_TRUE(e);
+  }
+  EXPECT_EQ(g_allocations.load() - before, 0);
 }
 
 TEST(RansacOptions, ValidateNamesTheBadKey) {
