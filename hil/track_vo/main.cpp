@@ -114,6 +114,17 @@ int main(int argc, char** argv) {
   }
   if (auto s = opt.validate(); !s.isOk()) return usage(s.toString().c_str());
 
+  static constexpr const char* kLoss[] = {"none", "huber", "cauchy"};
+  std::printf(
+      "options: window %d%s, ransac thr %.2f px iters %d min_inliers %d, sigma u/v/d "
+      "%.2f/%.2f/%.2f px, loss %s scale %.2f, solver max_iter %d max_time %.3f s, "
+      "min_disparity %.2f px, motion prior %.3f deg / %.3f m, seed %llu\n",
+      opt.window.window_size, opt.use_window ? "" : " (disabled)", opt.ransac.inlier_threshold_px,
+      opt.ransac.max_iterations, opt.ransac.min_inliers, opt.window.sigma_u_px,
+      opt.window.sigma_v_px, opt.window.sigma_d_px, kLoss[static_cast<int>(opt.window.loss)],
+      opt.window.loss_scale, opt.window.max_num_iterations, opt.window.max_solver_time_in_seconds,
+      opt.ransac.min_disparity_px, opt.window.motion_prior_sigma_rot_deg,
+      opt.window.motion_prior_sigma_trans_m, static_cast<unsigned long long>(opt.seed));
   auto seq = sunvo::files::readTrackFolder(folder, sunvo::files::TrackReadOptions{});
   if (!seq) {
     std::fprintf(stderr, "sunvo_track_vo: %s\n", seq.status().toString().c_str());
