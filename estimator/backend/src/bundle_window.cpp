@@ -252,7 +252,12 @@ Expected<WindowSolveSummary> BundleWindow::solve() {
   for (auto g = begin; g != end;) {
     auto g_end = g;
     while (g_end != end && g_end->landmark_id == g->landmark_id) ++g_end;
-    const auto count = g_end - g;
+    // Number of distinct frames (entries are sorted by slot within a landmark); a duplicated id
+    // within one frame does not count as a second view.
+    int count = 0;
+    for (auto e = g; e != g_end; ++e) {
+      if (e == g || e->slot != (e - 1)->slot) ++count;
+    }
     if (count >= 2 && n_landmarks < options_.max_landmarks) {
       // Initialise p_b from the first observation with enough disparity: p_j from Eq. 1 inverted,
       // p_b = T_j_b^-1 p_j.

@@ -21,6 +21,13 @@ std::uint64_t mixSeed(std::uint64_t x) {
 
 }  // namespace
 
+// Frames between a reference and the new frame, at least 1 (sequence numbers that repeat or go
+// back are treated as consecutive).
+double StereoOdometry::frameGap(const FrameFeatures& frame, const RefFrame& ref) {
+  const auto d = static_cast<std::int64_t>(frame.sequence - ref.sequence);
+  return d < 1 ? 1.0 : static_cast<double>(d);
+}
+
 const char* toString(TrackingStatus s) {
   switch (s) {
     case TrackingStatus::kInitializing:
@@ -165,8 +172,7 @@ Expected<VoResult> StereoOdometry::process(const FrameFeatures& frame) {
     auto e = ransac_.estimate(std::span(matches_.data(), static_cast<std::size_t>(n_matches)),
                               mixSeed(options_.seed ^ frame.sequence));
     if (e && e->T_k_km1.translation().norm() <=
-                 options_.max_translation_per_frame_m *
-                     static_cast<double>(frame.sequence - candidate->sequence)) {
+                 options_.max_translation_per_frame_m * frameGap(frame, *candidate)) {
       est = *e;
       ref = candidate;
       break;
@@ -188,7 +194,7 @@ Expected<VoResult> StereoOdometry::process(const FrameFeatures& frame) {
     return r;
   }
   r.ransac_inliers = est.num_inliers;
-  r.reference_gap = static_cast<int>(frame.sequence - ref->sequence);
+  r.reference_gap = static_cast<int>(frameGap(frame, *ref));
   Isometry3 T_w_k = ref->T_w_c * est.T_k_km1.inverse();
 
   if (options_.use_window) {

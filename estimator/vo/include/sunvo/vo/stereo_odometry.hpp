@@ -87,6 +87,7 @@ class StereoOdometry {
     bool valid = false;
   };
   void store(RefFrame& ref, const FrameFeatures& frame, const Isometry3& T_w_c);
+  static double frameGap(const FrameFeatures& frame, const RefFrame& ref);
   int associate(const RefFrame& ref, const FrameFeatures& frame);
   int baseObservations(const RefFrame& ref);
   Status restartWindowAt(const RefFrame& ref);
