@@ -1,0 +1,179 @@
+#pragma once
+// A bounded sliding window of N stereo poses solved with Ceres (the paper's back end).
+//
+// The window holds the last N frames (N = window_size, default 2). Its base frame b is the oldest
+// frame; the base's world pose T_w_b is fixed (it came from the previous windows). Unknowns: the
+// other poses T_k_b (unit quaternion with ceres::EigenQuaternionManifold + translation) and the
+// positions p_b of the landmarks seen in at least two window frames, initialised by stereo
+// triangulation in the first frame that sees them with enough disparity.
+//
+// Memory: everything is sized in init(). The ceres::Problem lives as long as the window and is
+// created with enable_fast_removal; its pose blocks (one per window slot) and landmark blocks (one
+// per landmark slot, max_landmarks) point into fixed arrays and are added once in init(); unused
+// landmark blocks have no residuals and Ceres drops them from the reduced program. Each solve()
+// removes the previous residual blocks and adds the new ones, using a pool of stereo cost functions
+// (created once, DO_NOT_TAKE_OWNERSHIP) bound to fixed measurement slots. Nothing grows with the
+// run length; the only per-solve allocations are Ceres' own bounded bookkeeping.
+//
+// Extension hook: a caller may add one more residual type per pose (e.g. an absolute direction,
+// the sun: s_hat_k = C_k_b C_b_w s_w) through setPoseResidualHook(); the hook is called in solve()
+// after the stereo blocks are in, may read T_w_b(), frame times and sequences, and calls
+// addPoseResidual() for any slot. Its cost functions and losses stay owned by the caller.
+
+#include <ceres/loss_function.h>
+#include <ceres/manifold.h>
+#include <ceres/problem.h>
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "sunvo/backend/stereo_residual.hpp"
+#include "sunvo/core/camera.hpp"
+#include "sunvo/core/geometry.hpp"
+#include "sunvo/core/status.hpp"
+#include "sunvo/core/time.hpp"
+
+namespace sunvo::backend {
+
+enum class RobustLoss { kNone, kHuber, kCauchy };
+
+struct WindowOptions {
+  int window_size = 2;                    // poses, [2, kMaxWindowSize]
+  int max_observations_per_frame = 2000;  // count, >= 3: observations kept per window frame
+  int max_landmarks = 2000;               // count, >= 3: landmarks per window (extra ones skipped)
+  double sigma_u_px = 1.0;                // px, > 0: std of the u measurement
+  double sigma_v_px = 1.0;                // px, > 0: std of the v measurement
+  double sigma_d_px = 1.0;                // px, > 0: std of the disparity measurement
+  RobustLoss loss = RobustLoss::kCauchy;  // robust loss on the whitened residual
+  double loss_scale = 2.0;                // whitened units (sigmas), > 0: Huber/Cauchy scale
+  double min_disparity_px = 1.0;  // px, > 0: smallest disparity used to triangulate a landmark
+  int max_num_iterations = 10;    // count, [1, 1000]: Ceres iterations per solve
+  double max_solver_time_in_seconds = 0.05;
+  // Soft prior on each frame's motion relative to the previous window frame, when addFrame() is
+  // given a predicted motion (e.g. constant velocity). 0 disables it.
+  double motion_prior_sigma_rot_deg = 0.0;  // deg, >= 0: std of the rotation deviation
+  double motion_prior_sigma_trans_m =
+      0.0;  // m, >= 0: std of the translation deviation  // s, > 0: Ceres time limit per solve
+
+  Status validate() const;
+};
+
+// One measurement of the window: landmark id and (u, v, d) in px.
+struct WindowObservation {
+  std::int64_t landmark_id = -1;
+  StereoMeasurement y;
+};
+
+struct WindowSolveSummary {
+  int num_landmarks = 0;
+  int num_stereo_residuals = 0;
+  int num_prior_residuals = 0;
+  int num_extra_residuals = 0;
+  int iterations = 0;
+  double solver_time_s = 0.0;
+  double initial_cost = 0.0;
+  double final_cost = 0.0;
+  bool converged = false;  // Ceres reported CONVERGENCE (else NO_CONVERGENCE / time limit)
+};
+
+class BundleWindow {
+ public:
+  static constexpr int kMaxWindowSize = 8;
+
+  BundleWindow();
+  ~BundleWindow();
+  BundleWindow(const BundleWindow&) = delete;
+  BundleWindow& operator=(const BundleWindow&) = delete;
+
+  Status init(const WindowOptions& options, const StereoCamera& camera);
+
+  // Empties the window and makes the next addFrame() the base frame at world pose T_w_b.
+  void reset(const Isometry3& T_w_b);
+
+  // Appends a frame. T_k_km1_guess (initial guess, maps the previous newest frame into this one) is
+  // ignored for the first frame after reset(). When the window is full the oldest frame leaves and
+  // the next one becomes the base, its T_w_b chained from the current estimate.
+  // Fails (kInvalidArgument) when observations exceed max_observations_per_frame.
+  // motion_prior (optional): a predicted T_k_km1 used as a soft prior when the options enable it.
+  Status addFrame(std::uint64_t sequence, TimeNs time_ns, std::span<const WindowObservation> obs,
+                  const Isometry3& T_k_km1_guess, const Isometry3* motion_prior = nullptr);
+
+  // Builds the problem from the current frames and solves it. On a solver failure or a non-finite
+  // result the poses keep their initial guesses and an error is returned.
+  Expected<WindowSolveSummary> solve();
+
+  // Puts every pose back to the initial guess it had before the last solve() (e.g. when the
+  // caller rejects the solution).
+  void restoreInitialGuess() { poses_ = saved_poses_; }
+
+  int size() const { return size_; }
+  const Isometry3& T_w_b() const { return T_w_b_; }
+  // Pose of window slot i (0 = base = identity) relative to the base.
+  Isometry3 T_k_b(int slot) const;
+  Isometry3 T_w_newest() const;
+  std::uint64_t sequence(int slot) const {
+    return frames_[static_cast<std::size_t>(slot)].sequence;
+  }
+  TimeNs timeNs(int slot) const { return frames_[static_cast<std::size_t>(slot)].time_ns; }
+
+  // Hook for one more residual type per pose; see the header comment.
+  using PoseResidualHook = std::function<Status(BundleWindow& window)>;
+  void setPoseResidualHook(PoseResidualHook hook) { hook_ = std::move(hook); }
+  // Adds a residual on the rotation q_k_b (4 doubles, x y z w) of slot (1..size-1; the base is
+  // fixed). Only valid from inside the hook. cost and loss (may be null) stay owned by the caller
+  // and must live until the next solve().
+  Status addPoseResidual(int slot, ceres::CostFunction* cost, ceres::LossFunction* loss);
+
+  const WindowOptions& options() const { return options_; }
+
+ private:
+  struct Frame {
+    std::uint64_t sequence = 0;
+    TimeNs time_ns = 0;
+    std::vector<WindowObservation> obs;  // capacity max_observations_per_frame
+    int num_obs = 0;
+    bool has_prior = false;
+    MotionPriorData prior;  // relative to the previous slot
+  };
+  struct PoseBlock {
+    std::array<double, 4> q{0.0, 0.0, 0.0, 1.0};  // q_k_b, Eigen order x y z w
+    std::array<double, 3> t{0.0, 0.0, 0.0};       // t_k_b, m
+  };
+  struct Entry {
+    std::int64_t landmark_id;
+    int slot;
+    int obs;
+  };
+
+  void setPose(int slot, const Isometry3& T_k_b);
+  void clearResiduals();
+
+  WindowOptions options_;
+  StereoCamera camera_;
+  StereoModel model_;
+  bool initialized_ = false;
+  int size_ = 0;
+  Isometry3 T_w_b_ = Isometry3::Identity();
+  std::array<Frame, kMaxWindowSize> frames_;
+  std::array<PoseBlock, kMaxWindowSize> poses_;
+  std::array<PoseBlock, kMaxWindowSize> saved_poses_;
+  std::vector<std::array<double, 3>> landmarks_;  // p_b, max_landmarks
+  std::vector<Entry> entries_;                    // window_size * max_observations_per_frame
+  std::vector<StereoMeasurement> measurements_;   // one per stereo cost function
+  std::vector<std::unique_ptr<ceres::CostFunction>> cost_pool_;
+  std::array<std::unique_ptr<ceres::CostFunction>, kMaxWindowSize> prior_pool_;
+  std::vector<ceres::ResidualBlockId> residual_ids_;
+  int num_residuals_ = 0;
+  std::unique_ptr<ceres::LossFunction> loss_;
+  std::unique_ptr<ceres::Manifold> quaternion_manifold_;
+  std::unique_ptr<ceres::Problem> problem_;
+  PoseResidualHook hook_;
+  bool in_hook_ = false;
+  int num_extra_ = 0;
+};
+
+}  // namespace sunvo::backend

@@ -1,0 +1,131 @@
+#pragma once
+// The stereo observation residual of the paper's Eq. 1 for Ceres.
+
+#include <ceres/autodiff_cost_function.h>
+#include <ceres/cost_function.h>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace sunvo::backend {
+
+// A stereo measurement y = (u, v, d) of one landmark in one frame, in pixels.
+struct StereoMeasurement {
+  double u = 0.0;  // px, left image column
+  double v = 0.0;  // px, left image row
+  double d = 0.0;  // px, disparity u_left - u_right
+};
+
+// Constant data shared by all stereo residuals of a window: intrinsics and the square root of the
+// measurement information R_y^-1 = diag(1/su^2, 1/sv^2, 1/sd^2).
+struct StereoModel {
+  double fu = 0.0, fv = 0.0, cu = 0.0, cv = 0.0, baseline_m = 0.0;
+  double sqrt_info_u = 1.0;  // 1/px
+  double sqrt_info_v = 1.0;  // 1/px
+  double sqrt_info_d = 1.0;  // 1/px
+};
+
+// Residual of one stereo observation of landmark p_b (window base frame b) in camera k.
+//
+// Parameters: q_k_b (4, Eigen order x y z w, unit; EigenQuaternionManifold), t_k_b (3, m), p_b (3,
+// m).
+//   p_k = C_k_b p_b + t_k_b = (x, y, z)
+// Predicted measurement (Eq. 1), with fu, fv, cu, cv the rectified intrinsics and l the baseline:
+//   y_hat = (u, v, d) = (fu x / z + cu,  fv y / z + cv,  fu l / z)
+// Error e_y = y_hat - y and cost e_y^T R_y^-1 e_y with R_y = diag(su^2, sv^2, sd^2): Ceres
+// minimises |r|^2, so the residual is the whitened error
+//   r = R_y^{-1/2} e_y = (e_u / su, e_v / sv, e_d / sd).
+// A point at or behind the camera (z <= kMinDepth) has no valid projection: the residual is then a
+// large constant (kBehindCameraResidual in whitened units, zero derivatives), finite by
+// construction, so a step that pushes a point behind the camera is rejected by the trust region
+// without NaN; the robust loss bounds its influence.
+class StereoResidual {
+ public:
+  static constexpr double kMinDepth = 1e-3;             // m
+  static constexpr double kBehindCameraResidual = 1e3;  // whitened units
+
+  // y and model must outlive the residual; the window rewrites *y between solves.
+  StereoResidual(const StereoMeasurement* y, const StereoModel* model) : y_(y), model_(model) {}
+
+  template <typename T>
+  bool operator()(const T* q_k_b, const T* t_k_b, const T* p_b, T* residual) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> C_k_b(q_k_b);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t(t_k_b);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> p(p_b);
+    const Eigen::Matrix<T, 3, 1> p_k = C_k_b * p + t;
+    if (!(p_k.z() > T(kMinDepth))) {
+      residual[0] = residual[1] = residual[2] = T(kBehindCameraResidual);
+      return true;
+    }
+    const StereoModel& m = *model_;
+    const T inv_z = T(1.0) / p_k.z();
+    const T u_hat = T(m.fu) * p_k.x() * inv_z + T(m.cu);
+    const T v_hat = T(m.fv) * p_k.y() * inv_z + T(m.cv);
+    const T d_hat = T(m.fu * m.baseline_m) * inv_z;
+    residual[0] = T(m.sqrt_info_u) * (u_hat - T(y_->u));
+    residual[1] = T(m.sqrt_info_v) * (v_hat - T(y_->v));
+    residual[2] = T(m.sqrt_info_d) * (d_hat - T(y_->d));
+    return true;
+  }
+
+  // The caller owns the returned cost function (the window keeps a pool of them).
+  static ceres::CostFunction* Create(const StereoMeasurement* y, const StereoModel* model) {
+    return new ceres::AutoDiffCostFunction<StereoResidual, 3, 4, 3, 3>(
+        new StereoResidual(y, model));
+  }
+
+ private:
+  const StereoMeasurement* y_;
+  const StereoModel* model_;
+};
+
+// A predicted relative motion between consecutive window frames (e.g. constant velocity).
+struct MotionPriorData {
+  double q_pred[4] = {0.0, 0.0, 0.0, 1.0};  // C_k_km1 predicted, Eigen order x y z w
+  double t_pred[3] = {0.0, 0.0, 0.0};       // t_k_km1 predicted, m
+  double sqrt_info_rot = 1.0;               // 1/rad
+  double sqrt_info_trans = 1.0;             // 1/m
+};
+
+// Soft prior on the relative motion of slots km1 and k (both expressed in the base b):
+//   T_k_km1 = T_k_b T_km1_b^-1:  C = C_k_b C_km1_b^T,  t = t_k_b - C t_km1_b.
+// Rotation error: dq = q_pred^-1 * q(C); for a small error dq = (sin(a/2) n, cos(a/2)) so
+// 2 vec(dq) = a n, the rotation vector (sign chosen so that dq.w >= 0). Translation error
+// t - t_pred. Residual r = (2 vec(dq) / sigma_rot, (t - t_pred) / sigma_trans).
+class MotionPriorResidual {
+ public:
+  explicit MotionPriorResidual(const MotionPriorData* prior) : prior_(prior) {}
+
+  template <typename T>
+  bool operator()(const T* q_km1_b, const T* t_km1_b, const T* q_k_b, const T* t_k_b,
+                  T* residual) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> q_km1(q_km1_b);
+    const Eigen::Map<const Eigen::Quaternion<T>> q_k(q_k_b);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t_km1(t_km1_b);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t_k(t_k_b);
+    const Eigen::Quaternion<T> q_rel = q_k * q_km1.conjugate();
+    const Eigen::Matrix<T, 3, 1> t_rel = t_k - q_rel * t_km1;
+    const Eigen::Quaternion<T> q_pred(T(prior_->q_pred[3]), T(prior_->q_pred[0]),
+                                      T(prior_->q_pred[1]), T(prior_->q_pred[2]));
+    Eigen::Quaternion<T> dq = q_pred.conjugate() * q_rel;
+    const T sign = dq.w() < T(0.0) ? T(-1.0) : T(1.0);
+    const T sr = T(2.0 * prior_->sqrt_info_rot) * sign;
+    residual[0] = sr * dq.x();
+    residual[1] = sr * dq.y();
+    residual[2] = sr * dq.z();
+    for (int i = 0; i < 3; ++i) {
+      residual[3 + i] = T(prior_->sqrt_info_trans) * (t_rel[i] - T(prior_->t_pred[i]));
+    }
+    return true;
+  }
+
+  static ceres::CostFunction* Create(const MotionPriorData* prior) {
+    return new ceres::AutoDiffCostFunction<MotionPriorResidual, 6, 4, 3, 4, 3>(
+        new MotionPriorResidual(prior));
+  }
+
+ private:
+  const MotionPriorData* prior_;
+};
+
+}  // namespace sunvo::backend

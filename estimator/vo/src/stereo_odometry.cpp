@@ -1,0 +1,261 @@
+#include "sunvo/vo/stereo_odometry.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <string>
+
+namespace sunvo::vo {
+namespace {
+
+double msSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// splitmix64: decorrelates per-frame seeds.
+std::uint64_t mixSeed(std::uint64_t x) {
+  x += 0x9e3779b97f4a7c15ULL;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+  return x ^ (x >> 31);
+}
+
+}  // namespace
+
+// Frames between a reference and the new frame, at least 1 (sequence numbers that repeat or go
+// back are treated as consecutive).
+double StereoOdometry::frameGap(const FrameFeatures& frame, const RefFrame& ref) {
+  const auto d = static_cast<std::int64_t>(frame.sequence - ref.sequence);
+  return d < 1 ? 1.0 : static_cast<double>(d);
+}
+
+const char* toString(TrackingStatus s) {
+  switch (s) {
+    case TrackingStatus::kInitializing:
+      return "initializing";
+    case TrackingStatus::kTracking:
+      return "tracking";
+    case TrackingStatus::kLost:
+      return "lost";
+    case TrackingStatus::kRecovered:
+      return "recovered";
+  }
+  return "?";
+}
+
+Status VoOptions::validate() const {
+  SUNVO_RETURN_IF_ERROR(ransac.validate());
+  SUNVO_RETURN_IF_ERROR(window.validate());
+  if (max_observations < 3) return invalidArgument("vo.max_observations must be >= 3");
+  if (ransac.max_observations < max_observations) {
+    return invalidArgument("ransac.max_observations must be >= vo.max_observations");
+  }
+  if (window.max_observations_per_frame < max_observations) {
+    return invalidArgument("window.max_observations_per_frame must be >= vo.max_observations");
+  }
+  if (!(max_translation_per_frame_m > 0.0)) {
+    return invalidArgument("vo.max_translation_per_frame_m must be > 0");
+  }
+  return Status::ok();
+}
+
+Status StereoOdometry::init(const VoOptions& options, const StereoCamera& camera,
+                            const Isometry3& T_w_c0) {
+  SUNVO_RETURN_IF_ERROR(options.validate());
+  SUNVO_RETURN_IF_ERROR(camera.validate());
+  if (!allFinite(T_w_c0)) return invalidArgument("vo: non-finite T_w_c0");
+  options_ = options;
+  camera_ = camera;
+  SUNVO_RETURN_IF_ERROR(ransac_.init(options.ransac, camera));
+  if (options.use_window) SUNVO_RETURN_IF_ERROR(window_.init(options.window, camera));
+  const auto n = static_cast<std::size_t>(options.max_observations);
+  for (RefFrame* ref : {&good_, &lost_frame_}) {
+    ref->obs.assign(n, StereoObservation{});
+    ref->sorted.assign(n, IdIndex{});
+    ref->count = 0;
+    ref->valid = false;
+  }
+  matches_.assign(n, motion::StereoMatch{});
+  match_cur_index_.assign(n, 0);
+  window_obs_.assign(n, backend::WindowObservation{});
+  T_w_c0_ = T_w_c0;
+  T_w_last_ = T_w_c0;
+  last_motion_ = Isometry3::Identity();
+  have_motion_ = false;
+  lost_ = false;
+  initialized_ = true;
+  return Status::ok();
+}
+
+void StereoOdometry::store(RefFrame& ref, const FrameFeatures& frame, const Isometry3& T_w_c) {
+  ref.count = static_cast<int>(frame.observations.size());
+  for (int i = 0; i < ref.count; ++i) {
+    const auto ui = static_cast<std::size_t>(i);
+    ref.obs[ui] = frame.observations[ui];
+    ref.sorted[ui] = IdIndex{frame.observations[ui].landmark_id, i};
+  }
+  std::sort(ref.sorted.begin(), ref.sorted.begin() + ref.count,
+            [](const IdIndex& a, const IdIndex& b) { return a.id < b.id; });
+  ref.sequence = frame.sequence;
+  ref.time_ns = frame.time_ns;
+  ref.T_w_c = T_w_c;
+  ref.valid = true;
+}
+
+// Association by landmark id (binary search in the reference's sorted ids); fills matches_ and
+// match_cur_index_ (increasing current-frame indices).
+int StereoOdometry::associate(const RefFrame& ref, const FrameFeatures& frame) {
+  int n = 0;
+  const auto sorted_end = ref.sorted.begin() + ref.count;
+  for (std::size_t i = 0; i < frame.observations.size(); ++i) {
+    const StereoObservation& o = frame.observations[i];
+    const auto it = std::lower_bound(ref.sorted.begin(), sorted_end, o.landmark_id,
+                                     [](const IdIndex& a, std::int64_t id) { return a.id < id; });
+    if (it == sorted_end || it->id != o.landmark_id) continue;
+    const StereoObservation& p = ref.obs[static_cast<std::size_t>(it->index)];
+    const auto m = static_cast<std::size_t>(n++);
+    matches_[m] = {p.u_left, p.v_left, p.u_right, o.u_left, o.v_left, o.u_right};
+    match_cur_index_[m] = static_cast<int>(i);
+  }
+  return n;
+}
+
+// Window observations of a frame that starts a window: every one with positive disparity.
+int StereoOdometry::baseObservations(const RefFrame& ref) {
+  int n = 0;
+  for (int i = 0; i < ref.count; ++i) {
+    const StereoObservation& o = ref.obs[static_cast<std::size_t>(i)];
+    if (!(o.disparity() > 0.0)) continue;
+    window_obs_[static_cast<std::size_t>(n++)] = {o.landmark_id,
+                                                  {o.u_left, o.v_left, o.disparity()}};
+  }
+  return n;
+}
+
+Status StereoOdometry::restartWindowAt(const RefFrame& ref) {
+  if (!options_.use_window) return Status::ok();
+  window_.reset(ref.T_w_c);
+  const int n = baseObservations(ref);
+  return window_.addFrame(ref.sequence, ref.time_ns,
+                          std::span(window_obs_.data(), static_cast<std::size_t>(n)),
+                          Isometry3::Identity());
+}
+
+Expected<VoResult> StereoOdometry::process(const FrameFeatures& frame) {
+  if (!initialized_) return failedPrecondition("StereoOdometry::process before init");
+  if (frame.observations.size() > static_cast<std::size_t>(options_.max_observations)) {
+    return invalidArgument(
+        "vo: frame " + std::to_string(frame.sequence) + " has " +
+        std::to_string(frame.observations.size()) +
+        " observations > vo.max_observations = " + std::to_string(options_.max_observations));
+  }
+  VoResult r;
+  r.sequence = frame.sequence;
+  r.time_ns = frame.time_ns;
+
+  if (!good_.valid) {
+    r.T_w_c = T_w_c0_;
+    r.status = TrackingStatus::kInitializing;
+    T_w_last_ = T_w_c0_;
+    store(good_, frame, T_w_c0_);
+    SUNVO_RETURN_IF_ERROR(restartWindowAt(good_));
+    return r;
+  }
+
+  // RANSAC against the last good frame, then (after a loss) against the most recent lost frame.
+  const auto t_ransac = std::chrono::steady_clock::now();
+  const RefFrame* ref = nullptr;
+  motion::MotionEstimate est;
+  int n_matches = 0;
+  for (const RefFrame* candidate : {&good_, &lost_frame_}) {
+    if (!candidate->valid) continue;
+    n_matches = associate(*candidate, frame);
+    auto e = ransac_.estimate(std::span(matches_.data(), static_cast<std::size_t>(n_matches)),
+                              mixSeed(options_.seed ^ frame.sequence));
+    if (e && e->T_k_km1.translation().norm() <=
+                 options_.max_translation_per_frame_m * frameGap(frame, *candidate)) {
+      est = *e;
+      ref = candidate;
+      break;
+    }
+  }
+  r.num_matches = n_matches;
+  r.ransac_ms = msSince(t_ransac);
+
+  if (ref == nullptr) {
+    // Lost: predict, remember this frame as the most recent lost one, keep good_ and the window.
+    const Isometry3 motion =
+        options_.constant_velocity_on_loss ? last_motion_ : Isometry3::Identity();
+    r.T_k_km1 = motion;
+    r.T_w_c = T_w_last_ * motion.inverse();
+    r.status = TrackingStatus::kLost;
+    T_w_last_ = r.T_w_c;
+    store(lost_frame_, frame, r.T_w_c);
+    lost_ = true;
+    return r;
+  }
+  r.ransac_inliers = est.num_inliers;
+  r.reference_gap = static_cast<int>(frameGap(frame, *ref));
+  Isometry3 T_w_k = ref->T_w_c * est.T_k_km1.inverse();
+
+  if (options_.use_window) {
+    const auto t_window = std::chrono::steady_clock::now();
+    if (ref == &lost_frame_) SUNVO_RETURN_IF_ERROR(restartWindowAt(lost_frame_));
+    // Window observations of frame k: RANSAC inliers among the matched, plus every unmatched
+    // observation with positive disparity (new landmarks for the next windows).
+    int n = 0;
+    int m = 0;
+    for (std::size_t i = 0; i < frame.observations.size(); ++i) {
+      const StereoObservation& o = frame.observations[i];
+      bool matched = false;
+      bool inlier = false;
+      if (m < n_matches && match_cur_index_[static_cast<std::size_t>(m)] == static_cast<int>(i)) {
+        matched = true;
+        inlier = est.inlier_mask[static_cast<std::size_t>(m)] != 0;
+        ++m;
+      }
+      if (matched ? !inlier : !(o.disparity() > 0.0)) continue;
+      window_obs_[static_cast<std::size_t>(n++)] = {o.landmark_id,
+                                                    {o.u_left, o.v_left, o.disparity()}};
+    }
+    // Constant-velocity prior: only between consecutive, well-tracked frames.
+    const bool use_prior = ref == &good_ && r.reference_gap == 1 && have_motion_;
+    SUNVO_RETURN_IF_ERROR(window_.addFrame(
+        frame.sequence, frame.time_ns, std::span(window_obs_.data(), static_cast<std::size_t>(n)),
+        est.T_k_km1, use_prior ? &last_motion_ : nullptr));
+    auto sol = window_.solve();
+    if (sol) {
+      const Isometry3 T_w_new = window_.T_w_newest();
+      const Isometry3 motion = T_w_new.inverse() * ref->T_w_c;
+      if (allFinite(T_w_new) &&
+          motion.translation().norm() <=
+              options_.max_translation_per_frame_m * static_cast<double>(r.reference_gap)) {
+        T_w_k = T_w_new;
+        r.window_used = true;
+      } else {
+        window_.restoreInitialGuess();
+      }
+      r.window_landmarks = sol->num_landmarks;
+      r.window_residuals = sol->num_stereo_residuals;
+      r.solver_iterations = sol->iterations;
+      r.solver_time_s = sol->solver_time_s;
+    }
+    if (!r.window_used) T_w_k = window_.T_w_newest();  // the RANSAC guess chained in the window
+    r.window_ms = msSince(t_window);
+  }
+  if (!allFinite(T_w_k)) T_w_k = ref->T_w_c * est.T_k_km1.inverse();
+
+  r.T_k_km1 = T_w_k.inverse() * T_w_last_;
+  r.T_w_c = T_w_k;
+  r.status = lost_ ? TrackingStatus::kRecovered : TrackingStatus::kTracking;
+  if (r.reference_gap == 1) {
+    last_motion_ = T_w_k.inverse() * ref->T_w_c;
+    have_motion_ = true;
+  }
+  lost_ = false;
+  lost_frame_.valid = false;
+  T_w_last_ = T_w_k;
+  store(good_, frame, T_w_k);
+  return r;
+}
+
+}  // namespace sunvo::vo
