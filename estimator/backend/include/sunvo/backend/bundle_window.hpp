@@ -52,12 +52,11 @@ struct WindowOptions {
   double loss_scale = 2.0;                // whitened units (sigmas), > 0: Huber/Cauchy scale
   double min_disparity_px = 1.0;  // px, > 0: smallest disparity used to triangulate a landmark
   int max_num_iterations = 10;    // count, [1, 1000]: Ceres iterations per solve
-  double max_solver_time_in_seconds = 0.05;
+  double max_solver_time_in_seconds = 0.05;  // s, > 0: Ceres time limit per solve
   // Soft prior on each frame's motion relative to the previous window frame, when addFrame() is
   // given a predicted motion (e.g. constant velocity). 0 disables it.
   double motion_prior_sigma_rot_deg = 0.0;  // deg, >= 0: std of the rotation deviation
-  double motion_prior_sigma_trans_m =
-      0.0;  // m, >= 0: std of the translation deviation  // s, > 0: Ceres time limit per solve
+  double motion_prior_sigma_trans_m = 0.0;  // m, >= 0: std of the translation deviation
 
   Status validate() const;
 };
