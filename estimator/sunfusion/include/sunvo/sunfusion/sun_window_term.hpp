@@ -12,11 +12,11 @@
 // Nothing here allocates per frame except the cost function of an accepted measurement (every
 // fifth frame by default), which lives until it leaves the window.
 
+#include <ceres/loss_function.h>
+
 #include <array>
 #include <memory>
 #include <optional>
-
-#include <ceres/loss_function.h>
 
 #include "sunvo/backend/bundle_window.hpp"
 #include "sunvo/sunfusion/sun_gate.hpp"
@@ -25,7 +25,7 @@
 namespace sunvo::sunfusion {
 
 struct SunObservation {
-  SunMeasurement measurement;  // in camera k (k = measurement.sequence)
+  SunMeasurement measurement;                        // in camera k (k = measurement.sequence)
   Eigen::Vector3d sun_w = Eigen::Vector3d::UnitZ();  // unit vector toward the sun, VO world frame
 };
 

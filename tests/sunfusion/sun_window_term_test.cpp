@@ -1,0 +1,142 @@
+#include "sunvo/sunfusion/sun_window_term.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "sunvo/sunfusion/simulated_sun_source.hpp"
+
+namespace sunvo::sunfusion {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+// A two-frame window whose base world pose carries a yaw error (as accumulated VO drift would),
+// with exact stereo observations of 150 points. Without a sun term the new frame inherits the
+// error; a sun measurement pulls its world orientation back toward the truth (by a share).
+class SunWindowTermTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    camera_ = {718.856, 718.856, 607.1928, 185.2157, 0.53716, 1241, 376};
+    backend::WindowOptions wopt;
+    wopt.max_num_iterations = 50;
+    ASSERT_TRUE(window_.init(wopt, camera_).isOk());
+    T_k_b_true_ = Isometry3::Identity();
+    T_k_b_true_.linear() = expSO3(Eigen::Vector3d(0.0, 2.0 * kDeg, 0.0));
+    T_k_b_true_.translation() = Eigen::Vector3d(0.02, 0.0, -1.0);
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> x(-15, 15), y(-3, 1.5), z(6, 40);
+    for (int i = 0; i < 150; ++i) {
+      const Eigen::Vector3d p_b(x(rng), y(rng), z(rng));
+      const Eigen::Vector3d y_b = camera_.project(p_b);
+      const Eigen::Vector3d y_k = camera_.project(T_k_b_true_ * p_b);
+      obs_b_.push_back({i, {y_b.x(), y_b.y(), y_b.z()}});
+      obs_k_.push_back({i, {y_k.x(), y_k.y(), y_k.z()}});
+    }
+    // Truth: the base is the world origin. Estimate: the base is 2 deg off in yaw.
+    T_w_b_est_ = Isometry3::Identity();
+    T_w_b_est_.linear() = expSO3(Eigen::Vector3d(0.0, 2.0 * kDeg, 0.0));
+    sun_w_ = sunFromAzimuthZenith(70.0 * kDeg, 50.0 * kDeg);  // world = camera-like frame here
+  }
+
+  // Solves the window and returns the world yaw error of the new frame in degrees.
+  double solveAndYawError(SunWindowTerm* term, const std::optional<SunObservation>& obs) {
+    window_.reset(T_w_b_est_);
+    if (term != nullptr) term->attach(window_);
+    if (term != nullptr && obs) term->addObservation(*obs);
+    EXPECT_TRUE(window_.addFrame(0, 0, obs_b_, Isometry3::Identity()).isOk());
+    EXPECT_TRUE(window_.addFrame(1, 100'000'000, obs_k_, T_k_b_true_).isOk());
+    auto summary = window_.solve();
+    EXPECT_TRUE(summary) << summary.status().toString();
+    const Isometry3 T_w_k_true = T_k_b_true_.inverse();
+    const Eigen::Matrix3d dC = window_.T_w_newest().linear() * T_w_k_true.linear().transpose();
+    return std::abs(logSO3(dC).y()) / kDeg;
+  }
+
+  SunObservation perfectObservation(SunMeasurementKind kind, double sigma) const {
+    SunObservation o;
+    o.sun_w = sun_w_;
+    o.measurement.sequence = 1;
+    o.measurement.kind = kind;
+    o.measurement.sigma = sigma;
+    const Eigen::Vector3d sun_k = T_k_b_true_.linear() * sun_w_;  // truth: C_b_w = I
+    o.measurement.sun_c = kind == SunMeasurementKind::kAzimuthOnly
+                              ? Eigen::Vector3d(xzDirection(sun_k).x(), 0.0, xzDirection(sun_k).y())
+                              : sun_k;
+    return o;
+  }
+
+  StereoCamera camera_;
+  backend::BundleWindow window_;
+  Isometry3 T_k_b_true_, T_w_b_est_;
+  std::vector<backend::WindowObservation> obs_b_, obs_k_;
+  Eigen::Vector3d sun_w_;
+};
+
+SunFusionOptions cameraWorldOptions() {
+  SunFusionOptions opt;
+  opt.world_up = Eigen::Vector3d(0, -1, 0);  // this world frame is camera-like (y down)
+  return opt;
+}
+
+TEST_F(SunWindowTermTest, WithoutSunTheNewFrameInheritsTheBaseError) {
+  EXPECT_NEAR(solveAndYawError(nullptr, std::nullopt), 2.0, 0.01);
+}
+
+TEST_F(SunWindowTermTest, FullSunMeasurementPullsOrientationBack) {
+  SunWindowTerm term;
+  ASSERT_TRUE(term.init(cameraWorldOptions()).isOk());
+  const double err =
+      solveAndYawError(&term, perfectObservation(SunMeasurementKind::kFull3d, 0.001));
+  // In the paper's formulation the base's world pose is fixed, and 150 exact stereo points pin the
+  // relative rotation C_k_b stiffly, so one window removes only a share of the absolute error
+  // (measured: 6.9 %); repeated every fifth frame the shares compound and bound the drift.
+  EXPECT_LT(err, 1.95);
+  EXPECT_GT(err, 1.5);
+  // A looser sun term corrects less.
+  SunWindowTerm loose;
+  ASSERT_TRUE(loose.init(cameraWorldOptions()).isOk());
+  const double err_loose =
+      solveAndYawError(&loose, perfectObservation(SunMeasurementKind::kFull3d, 0.01));
+  EXPECT_GT(err_loose, err);
+  EXPECT_LT(err_loose, 2.0);
+  EXPECT_EQ(term.counters().accepted, 1u);
+  EXPECT_EQ(window_.T_w_b().linear(), T_w_b_est_.linear());  // the base itself stays fixed
+}
+
+TEST_F(SunWindowTermTest, AzimuthOnlyMeasurementAlsoCorrectsYaw) {
+  SunWindowTerm term;
+  ASSERT_TRUE(term.init(cameraWorldOptions()).isOk());
+  const double err =
+      solveAndYawError(&term, perfectObservation(SunMeasurementKind::kAzimuthOnly, 0.001));
+  EXPECT_LT(err, 1.9);  // measured 1.68: the in-plane chord acts on yaw alone
+  EXPECT_EQ(term.counters().accepted, 1u);
+}
+
+TEST_F(SunWindowTermTest, GatedMeasurementLeavesTheSolutionUnchanged) {
+  SunWindowTerm term;
+  ASSERT_TRUE(term.init(cameraWorldOptions()).isOk());
+  SunObservation wrong = perfectObservation(SunMeasurementKind::kFull3d, 0.001);
+  wrong.measurement.sun_c = sunFromAzimuthZenith(-110.0 * kDeg, 50.0 * kDeg);  // shadow flip
+  const double err = solveAndYawError(&term, wrong);
+  EXPECT_NEAR(err, 2.0, 0.01);
+  EXPECT_EQ(term.counters().rejected_cosine, 1u);
+  EXPECT_EQ(term.counters().accepted, 0u);
+  ASSERT_TRUE(term.lastDecision().has_value());
+  EXPECT_EQ(*term.lastDecision(), GateResult::kRejectedCosine);
+}
+
+TEST_F(SunWindowTermTest, SunBelowHorizonIsNotUsed) {
+  SunWindowTerm term;
+  ASSERT_TRUE(term.init(cameraWorldOptions()).isOk());
+  SunObservation night = perfectObservation(SunMeasurementKind::kFull3d, 0.001);
+  night.sun_w = sunFromAzimuthZenith(70.0 * kDeg, 100.0 * kDeg);  // 10 degrees below
+  night.measurement.sun_c = T_k_b_true_.linear() * night.sun_w;
+  EXPECT_NEAR(solveAndYawError(&term, night), 2.0, 0.01);
+  EXPECT_EQ(term.counters().rejected_sun_down, 1u);
+}
+
+}  // namespace
+}  // namespace sunvo::sunfusion
