@@ -75,9 +75,18 @@ class SunWindowTermTest : public ::testing::Test {
   Eigen::Vector3d sun_w_;
 };
 
+// The paper's form: the base's world attitude is held fixed.
 SunFusionOptions cameraWorldOptions() {
   SunFusionOptions opt;
   opt.world_up = Eigen::Vector3d(0, -1, 0);  // this world frame is camera-like (y down)
+  opt.estimate_base_attitude = false;
+  return opt;
+}
+
+SunFusionOptions baseAttitudeOptions() {
+  SunFusionOptions opt = cameraWorldOptions();
+  opt.estimate_base_attitude = true;
+  opt.initial_attitude_sigma_deg = 3.0;
   return opt;
 }
 
@@ -136,6 +145,56 @@ TEST_F(SunWindowTermTest, SunBelowHorizonIsNotUsed) {
   night.measurement.sun_c = T_k_b_true_.linear() * night.sun_w;
   EXPECT_NEAR(solveAndYawError(&term, night), 2.0, 0.01);
   EXPECT_EQ(term.counters().rejected_sun_down, 1u);
+}
+
+// One sun direction observes two of the three attitude degrees of freedom: the rotation about
+// the sun axis is invisible to it. The base-attitude mode must remove the observable part of the
+// error (perpendicular to the sun) and leave the invisible part alone.
+double perpendicularErrorDeg(const Eigen::Matrix3d& C_w_est, const Eigen::Vector3d& sun_w) {
+  const Eigen::Vector3d e = logSO3(C_w_est);  // truth is the identity here
+  return (e - e.dot(sun_w) * sun_w).norm() / kDeg;
+}
+
+TEST_F(SunWindowTermTest, BaseAttitudeModeRemovesTheObservableError) {
+  SunWindowTerm term;
+  ASSERT_TRUE(term.init(baseAttitudeOptions()).isOk());
+  EXPECT_NEAR(perpendicularErrorDeg(T_w_b_est_.linear(), sun_w_), 2.0 * 0.7660, 1e-3);
+  solveAndYawError(&term, perfectObservation(SunMeasurementKind::kFull3d, 0.01));
+  // The 1.53 degree observable error is within the 3 degree prior; a measurement with
+  // sigma = 0.01 rad (0.573 deg) leaves the Kalman share s^2 / (s^2 + p^2) = 3.52 % of it, in the
+  // base and in the new frame.
+  const double expected = 2.0 * 0.7660 * 0.573 * 0.573 / (0.573 * 0.573 + 9.0);
+  EXPECT_NEAR(perpendicularErrorDeg(window_.T_w_b().linear(), sun_w_), expected, 0.005);
+  const Eigen::Matrix3d C_w_k_true = T_k_b_true_.inverse().linear();
+  EXPECT_NEAR(perpendicularErrorDeg(window_.T_w_newest().linear() * C_w_k_true.transpose(), sun_w_),
+              expected, 0.005);
+  // The unobservable part (2 deg * cos(50 deg) about the sun axis) is untouched.
+  EXPECT_NEAR(rotationAngle(window_.T_w_b().linear()) / kDeg, 2.0 * 0.6428, 0.02);
+  // The attitude uncertainty shrank across the sun axis only.
+  const Eigen::Matrix3d& P = term.attitudeCovariance();
+  EXPECT_NEAR(sun_w_.dot(P * sun_w_), std::pow(3.0 * kDeg, 2), 1e-6);
+  EXPECT_LT(P.trace(), 1.5 * std::pow(3.0 * kDeg, 2));
+}
+
+TEST_F(SunWindowTermTest, BaseAttitudeModeWithAzimuthOnlyCorrectsTheObservablePart) {
+  SunWindowTerm term;
+  ASSERT_TRUE(term.init(baseAttitudeOptions()).isOk());
+  const double before = solveAndYawError(nullptr, std::nullopt);
+  SunWindowTerm az;
+  ASSERT_TRUE(az.init(baseAttitudeOptions()).isOk());
+  const double after =
+      solveAndYawError(&az, perfectObservation(SunMeasurementKind::kAzimuthOnly, 0.01));
+  EXPECT_LT(after, 0.5 * before);
+  EXPECT_EQ(az.counters().accepted, 1u);
+}
+
+TEST_F(SunWindowTermTest, BaseAttitudeModeWeighsAnImpreciseMeasurementAgainstThePrior) {
+  // sigma 0.1 (about 6 degrees) against a 3 degree prior: a partial, not a full, correction.
+  SunWindowTerm term;
+  ASSERT_TRUE(term.init(baseAttitudeOptions()).isOk());
+  const double err = solveAndYawError(&term, perfectObservation(SunMeasurementKind::kFull3d, 0.1));
+  EXPECT_GT(err, 0.2);
+  EXPECT_LT(err, 1.8);
 }
 
 }  // namespace

@@ -226,6 +226,35 @@ Status BundleWindow::addPoseResidual(int slot, ceres::CostFunction* cost,
   return Status::ok();
 }
 
+Status BundleWindow::addResidual(int slot, ceres::CostFunction* cost, ceres::LossFunction* loss,
+                                 std::span<double* const> extra_blocks) {
+  if (!in_hook_) return failedPrecondition("window: addResidual outside the pose hook");
+  if (slot >= size_ || slot == 0) {
+    return invalidArgument("window: addResidual slot " + std::to_string(slot) + " not in [1, " +
+                           std::to_string(size_) + ") or < 0");
+  }
+  const std::size_t n_blocks = extra_blocks.size() + (slot > 0 ? 1u : 0u);
+  if (cost == nullptr || cost->parameter_block_sizes().size() != n_blocks || n_blocks == 0 ||
+      n_blocks > 4 || (slot > 0 && cost->parameter_block_sizes()[0] != 4)) {
+    return invalidArgument("window: addResidual blocks do not match the cost function");
+  }
+  if (num_residuals_ >= static_cast<int>(residual_ids_.size())) {
+    return invalidArgument("window: too many extra residuals");
+  }
+  std::array<double*, 4> blocks{};
+  std::size_t i = 0;
+  if (slot > 0) blocks[i++] = poses_[static_cast<std::size_t>(slot)].q.data();
+  for (double* b : extra_blocks) blocks[i++] = b;
+  residual_ids_[static_cast<std::size_t>(num_residuals_++)] =
+      problem_->AddResidualBlock(cost, loss, blocks.data(), static_cast<int>(n_blocks));
+  ++num_extra_;
+  return Status::ok();
+}
+
+void BundleWindow::correctBaseAttitude(const Eigen::Matrix3d& C_b_bnew) {
+  T_w_b_.linear() = orthonormalize(T_w_b_.linear() * C_b_bnew);
+}
+
 Expected<WindowSolveSummary> BundleWindow::solve() {
   if (!initialized_) return failedPrecondition("BundleWindow::solve before init");
   if (size_ < 2) return failedPrecondition("window: solve needs at least 2 frames");
@@ -345,6 +374,7 @@ Expected<WindowSolveSummary> BundleWindow::solve() {
   out.initial_cost = summary.initial_cost;
   out.final_cost = summary.final_cost;
   out.converged = summary.termination_type == ceres::CONVERGENCE;
+  if (post_hook_) post_hook_(*this);
   return out;
 }
 

@@ -126,6 +126,18 @@ class BundleWindow {
   // fixed). Only valid from inside the hook. cost and loss (may be null) stay owned by the caller
   // and must live until the next solve().
   Status addPoseResidual(int slot, ceres::CostFunction* cost, ceres::LossFunction* loss);
+  // As addPoseResidual, over the rotation of `slot` followed by caller-owned parameter blocks
+  // (e.g. a correction of the base's world attitude), which must stay valid until the next
+  // solve(). slot < 0: a residual on the caller's blocks alone (e.g. their prior).
+  Status addResidual(int slot, ceres::CostFunction* cost, ceres::LossFunction* loss,
+                     std::span<double* const> extra_blocks);
+
+  // Called after a successful solve (not after a failed one), e.g. to apply a correction.
+  using PostSolveHook = std::function<void(BundleWindow& window)>;
+  void setPostSolveHook(PostSolveHook hook) { post_hook_ = std::move(hook); }
+  // Rotates the base's world attitude about the base's own origin: C_w_b <- C_w_b * C_b_bnew.
+  // Every world pose the window derives afterwards (newest pose, the next base) follows.
+  void correctBaseAttitude(const Eigen::Matrix3d& C_b_bnew);
 
   const WindowOptions& options() const { return options_; }
 
@@ -171,6 +183,7 @@ class BundleWindow {
   std::unique_ptr<ceres::Manifold> quaternion_manifold_;
   std::unique_ptr<ceres::Problem> problem_;
   PoseResidualHook hook_;
+  PostSolveHook post_hook_;
   bool in_hook_ = false;
   int num_extra_ = 0;
 };

@@ -3,8 +3,9 @@
 //
 // The window's base frame b is fixed during a solve; C_b_w (world -> base rotation) comes from the
 // previous window, and s_w (unit vector toward the sun in the world frame) from the ephemeris at
-// the measurement's time and place. The only unknown the residual touches is the rotation of
-// camera k in the base frame, q_k_b (Eigen quaternion order x, y, z, w).
+// the measurement's time and place. The residual touches the rotation of camera k in the base
+// frame, q_k_b (Eigen quaternion order x, y, z, w), and optionally a correction delta of the base's
+// world attitude (see predictSun).
 
 #include <ceres/autodiff_cost_function.h>
 #include <ceres/rotation.h>
@@ -15,10 +16,31 @@
 
 namespace sunvo::sunfusion {
 
+// The sun predicted in camera k.
+//
+// Paper form (base fixed):   s_hat_k = C_k_b s_b,            s_b = C_b_w s_w.
+// With a base correction delta (rotation vector: the error of the base's world attitude, so that
+// C_w_b,true = C_w_b Exp(delta) and C_b_w,true = Exp(-delta) C_b_w):
+//                            s_hat_k = C_k_b Exp(-delta) s_b.
+// The correction carries a prior delta ~ N(0, P) from the accumulated attitude uncertainty (the
+// term the paper left to future work), so a measurement can remove an old attitude error instead
+// of only nudging the stiff relative rotation C_k_b. delta == nullptr gives the paper form.
+template <typename T>
+Eigen::Matrix<T, 3, 1> predictSun(const T* q_k_b, const T* delta, const Eigen::Vector3d& sun_b) {
+  const Eigen::Map<const Eigen::Quaternion<T>> C_k_b(q_k_b);
+  Eigen::Matrix<T, 3, 1> s_b = sun_b.cast<T>();
+  if (delta != nullptr) {
+    const T minus_delta[3] = {-delta[0], -delta[1], -delta[2]};
+    Eigen::Matrix<T, 3, 1> rotated;
+    ceres::AngleAxisRotatePoint(minus_delta, s_b.data(), rotated.data());
+    s_b = rotated;
+  }
+  return C_k_b * s_b;
+}
+
 // Full 3-D sun residual (the paper's Eq. 3 term).
 //
-//   predicted  s_hat_k = C_k_b * (C_b_w * s_w) = C_k_b * s_b        (s_b fixed during the solve)
-//   residual   e_s     = s_hat_k - s_k                               (3-vector, Euclidean)
+//   residual   e_s = s_hat_k - s_k                                 (3-vector, Euclidean)
 //   cost       e_s^T R_s^-1 e_s with R_s = sigma^2 I, so the weighted residual is e_s / sigma.
 //
 // The paper found the Euclidean difference of unit vectors converged better in Ceres than the
@@ -32,19 +54,35 @@ class SunDirectionResidual {
 
   template <typename T>
   bool operator()(const T* q_k_b, T* residual) const {
-    const Eigen::Map<const Eigen::Quaternion<T>> C_k_b(q_k_b);
-    const Eigen::Matrix<T, 3, 1> s_hat = C_k_b * sun_b_.cast<T>();
-    for (int i = 0; i < 3; ++i) residual[i] = (s_hat[i] - T(sun_k_[i])) * T(inv_sigma_);
-    return true;
+    return evaluate(q_k_b, static_cast<const T*>(nullptr), residual);
+  }
+  template <typename T>
+  bool operator()(const T* q_k_b, const T* delta, T* residual) const {
+    return evaluate(q_k_b, delta, residual);
   }
 
+  // Blocks: q_k_b (4).
   static ceres::CostFunction* Create(const Eigen::Vector3d& sun_b,
                                      const Eigen::Vector3d& sun_k_measured, double sigma) {
     return new ceres::AutoDiffCostFunction<SunDirectionResidual, 3, 4>(
         new SunDirectionResidual(sun_b, sun_k_measured, sigma));
   }
+  // Blocks: q_k_b (4), delta (3).
+  static ceres::CostFunction* CreateWithBaseCorrection(const Eigen::Vector3d& sun_b,
+                                                       const Eigen::Vector3d& sun_k_measured,
+                                                       double sigma) {
+    return new ceres::AutoDiffCostFunction<SunDirectionResidual, 3, 4, 3>(
+        new SunDirectionResidual(sun_b, sun_k_measured, sigma));
+  }
 
  private:
+  template <typename T>
+  bool evaluate(const T* q_k_b, const T* delta, T* residual) const {
+    const Eigen::Matrix<T, 3, 1> s_hat = predictSun(q_k_b, delta, sun_b_);
+    for (int i = 0; i < 3; ++i) residual[i] = (s_hat[i] - T(sun_k_[i])) * T(inv_sigma_);
+    return true;
+  }
+
   Eigen::Vector3d sun_b_;
   Eigen::Vector3d sun_k_;
   double inv_sigma_;
@@ -59,8 +97,8 @@ class SunDirectionResidual {
 // the x, z entries disagree in length with a normalised m. Instead the prediction is projected
 // onto the same plane and normalised:
 //
-//   s_hat_k = C_k_b s_b,   p = (s_hat_x, s_hat_z) / sqrt(s_hat_x^2 + s_hat_z^2)
-//   e_s     = p - m                                            (2-vector, chord in the x-z plane)
+//   p   = (s_hat_x, s_hat_z) / sqrt(s_hat_x^2 + s_hat_z^2)
+//   e_s = p - m                                                (2-vector, chord in the x-z plane)
 //
 // With a perfect measurement e_s = 0 at the true rotation for every sun elevation, so the term
 // leaves a correct pose unchanged. |e_s| = 2 sin(dpsi / 2) with dpsi the azimuth error in the
@@ -73,8 +111,31 @@ class SunAzimuthResidual {
 
   template <typename T>
   bool operator()(const T* q_k_b, T* residual) const {
-    const Eigen::Map<const Eigen::Quaternion<T>> C_k_b(q_k_b);
-    const Eigen::Matrix<T, 3, 1> s_hat = C_k_b * sun_b_.cast<T>();
+    return evaluate(q_k_b, static_cast<const T*>(nullptr), residual);
+  }
+  template <typename T>
+  bool operator()(const T* q_k_b, const T* delta, T* residual) const {
+    return evaluate(q_k_b, delta, residual);
+  }
+
+  // Blocks: q_k_b (4).
+  static ceres::CostFunction* Create(const Eigen::Vector3d& sun_b,
+                                     const Eigen::Vector2d& azimuth_xz, double sigma) {
+    return new ceres::AutoDiffCostFunction<SunAzimuthResidual, 2, 4>(
+        new SunAzimuthResidual(sun_b, azimuth_xz, sigma));
+  }
+  // Blocks: q_k_b (4), delta (3).
+  static ceres::CostFunction* CreateWithBaseCorrection(const Eigen::Vector3d& sun_b,
+                                                       const Eigen::Vector2d& azimuth_xz,
+                                                       double sigma) {
+    return new ceres::AutoDiffCostFunction<SunAzimuthResidual, 2, 4, 3>(
+        new SunAzimuthResidual(sun_b, azimuth_xz, sigma));
+  }
+
+ private:
+  template <typename T>
+  bool evaluate(const T* q_k_b, const T* delta, T* residual) const {
+    const Eigen::Matrix<T, 3, 1> s_hat = predictSun(q_k_b, delta, sun_b_);
     using std::sqrt;
     const T n = sqrt(s_hat.x() * s_hat.x() + s_hat.z() * s_hat.z() + T(1e-12));
     residual[0] = (s_hat.x() / n - T(m_.x())) * T(inv_sigma_);
@@ -82,16 +143,30 @@ class SunAzimuthResidual {
     return true;
   }
 
-  static ceres::CostFunction* Create(const Eigen::Vector3d& sun_b,
-                                     const Eigen::Vector2d& azimuth_xz, double sigma) {
-    return new ceres::AutoDiffCostFunction<SunAzimuthResidual, 2, 4>(
-        new SunAzimuthResidual(sun_b, azimuth_xz, sigma));
-  }
-
- private:
   Eigen::Vector3d sun_b_;
   Eigen::Vector2d m_;
   double inv_sigma_;
+};
+
+// Prior on the base-attitude correction: r = L delta with L^T L = P^-1 (square-root information
+// of the accumulated attitude uncertainty P).
+class AttitudePriorResidual {
+ public:
+  explicit AttitudePriorResidual(const Eigen::Matrix3d& sqrt_information) : L_(sqrt_information) {}
+  template <typename T>
+  bool operator()(const T* delta, T* residual) const {
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> d(delta);
+    Eigen::Map<Eigen::Matrix<T, 3, 1>> r(residual);
+    r = L_.cast<T>() * d;
+    return true;
+  }
+  static ceres::CostFunction* Create(const Eigen::Matrix3d& sqrt_information) {
+    return new ceres::AutoDiffCostFunction<AttitudePriorResidual, 3, 3>(
+        new AttitudePriorResidual(sqrt_information));
+  }
+
+ private:
+  Eigen::Matrix3d L_;
 };
 
 }  // namespace sunvo::sunfusion

@@ -9,8 +9,20 @@
 // made once per measurement (at its first solve) and counted. s_w is given per measurement in
 // the VO world frame, computed per frame by the caller (the sun moves ~0.25 deg/min).
 //
-// Nothing here allocates per frame except the cost function of an accepted measurement (every
-// fifth frame by default), which lives until it leaves the window.
+// Two ways to use an accepted measurement:
+//  - paper (estimate_base_attitude = false): C_b_w is fixed and the residual acts on C_k_b only.
+//    The stereo terms pin the relative rotation stiffly, so a window removes only a small share
+//    of an accumulated attitude error (measured in tests/sunfusion: ~7 % per window).
+//  - base attitude (default): the residual also acts on a correction delta of the base's world
+//    attitude, with a prior delta ~ N(0, P). P is the attitude uncertainty accumulated by VO: it
+//    starts at initial_attitude_sigma_deg and grows by attitude_drift_deg_per_frame^2 per frame
+//    (a random walk), and after each solve shrinks with the information of the sun residuals
+//    (P <- (P^-1 + sum J^T J)^-1, J = d(whitened residual)/d(delta) at the solution). After a
+//    successful solve the window's base attitude is corrected by Exp(delta). Each measurement is
+//    used in one solve only, so its information is not counted twice.
+//
+// Nothing here allocates per frame except the cost functions of an accepted measurement (every
+// fifth frame by default), which live until the next solve.
 
 #include <ceres/loss_function.h>
 
@@ -36,6 +48,10 @@ struct SunFusionOptions {
   Eigen::Vector3d world_up = Eigen::Vector3d::UnitZ();
   // Robust loss on the whitened sun residual: Cauchy scale in sigmas, (0, 100]; 0 = no loss.
   double loss_scale = 0.0;
+  // Estimate a correction of the base's world attitude (see above); false = the paper's form.
+  bool estimate_base_attitude = true;
+  double initial_attitude_sigma_deg = 1.0;     // deg, (0, 45]: first pose's attitude std
+  double attitude_drift_deg_per_frame = 0.05;  // deg, [0, 5]: random-walk std growth per frame
 
   Status validate() const;
 };
@@ -51,15 +67,19 @@ class SunWindowTerm {
   const GateCounters& counters() const { return counters_; }
   // Result of the gate for the last measurement decided (for logs and the sun thread).
   std::optional<GateResult> lastDecision() const { return last_decision_; }
+  // Current attitude uncertainty P (rad^2) of the VO world attitude (base-attitude mode).
+  const Eigen::Matrix3d& attitudeCovariance() const { return P_; }
 
  private:
   struct Pending {
     SunObservation obs;
     bool decided = false;
     bool accepted = false;
+    bool consumed = false;  // used in a base-attitude solve already
     std::unique_ptr<ceres::CostFunction> cost;
   };
   Status onSolve(backend::BundleWindow& window);
+  void onSolved(backend::BundleWindow& window);
 
   SunFusionOptions options_;
   std::unique_ptr<ceres::LossFunction> loss_;
@@ -67,6 +87,13 @@ class SunWindowTerm {
   std::array<bool, backend::BundleWindow::kMaxWindowSize> used_{};
   GateCounters counters_;
   std::optional<GateResult> last_decision_;
+  // Base-attitude mode state.
+  std::array<double, 3> delta_{0.0, 0.0, 0.0};
+  Eigen::Matrix3d P_ = Eigen::Matrix3d::Zero();
+  std::optional<std::uint64_t> last_sequence_;
+  std::unique_ptr<ceres::CostFunction> prior_cost_;
+  std::array<int, backend::BundleWindow::kMaxWindowSize> used_in_solve_{};  // ring indices
+  int num_used_ = 0;
 };
 
 }  // namespace sunvo::sunfusion
