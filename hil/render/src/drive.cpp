@@ -268,11 +268,14 @@ FrameLighting computeLighting(const Eigen::Vector3d& sun_enu, const SkyOptions& 
   Eigen::Vector3d E_sky_rgb;
   f.sky_illuminance_lux = model.horizontalIlluminanceLux(&E_sky_rgb);
   f.sun_normal_illuminance_lux = directSunIlluminanceLux(zs, sky.turbidity);
-  const double E_h =
-      f.sun_normal_illuminance_lux * std::max(std::cos(zs), 0.0) + f.sky_illuminance_lux;
   // Auto-exposure: a Lambertian patch of albedo rho has radiance rho E / pi; the scale k makes
-  // a sunlit horizontal albedo-0.25 patch read exposure_target (linear).
-  f.exposure_scale = exposure_target * kPi / (0.25 * std::max(E_h, 1.0));
+  // an albedo-0.25 patch lit by the sky and by the sun at an incidence of at most 60 deg
+  // (E_ref = E_sky + E_sun max(cos z_s, 0.5)) read exposure_target (linear). The 60 deg floor
+  // keeps a low sun from driving the exposure up until the sky saturates (facades facing a low
+  // sun are lit almost normally).
+  const double E_ref =
+      f.sun_normal_illuminance_lux * std::max(std::cos(zs), 0.5) + f.sky_illuminance_lux;
+  f.exposure_scale = exposure_target * kPi / (0.25 * std::max(E_ref, 1.0));
   // POV: colour = pigment (ambient_light + light cos); pigment = albedo rho, so the light colour
   // is k E_sun / pi and ambient k E_sky / pi. The ambient is the horizontal sky illuminance
   // times 0.8 (vertical faces see half the sky plus ground bounce; no radiosity).

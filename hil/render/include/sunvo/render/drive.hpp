@@ -33,8 +33,9 @@ struct SensorOptions {
   double read_noise_e = 12.0;    // read noise std, electrons, [0, 1000]
   double vignetting = 0.3;       // 0 = none; fraction of the cos^4 fall-off applied, [0, 1]
   double exposure_sigma = 0.02;  // per-frame log-gain innovation (AR(1), 0.9), [0, 0.5]
-  double exposure_target = 0.3;  // linear value of a sunlit horizontal albedo-0.25 patch, (0, 1]
-  double motion_blur_px = 0.0;   // horizontal box blur length, px, [0, 20]; 0 = off
+  double exposure_target =
+      0.3;  // linear value of an albedo-0.25 patch under E_sky + E_sun max(cos z_s, 0.5), (0, 1]
+  double motion_blur_px = 0.0;  // horizontal box blur length, px, [0, 20]; 0 = off
   Status validate() const;
 };
 
