@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
 #include "sunvo/render/drive.hpp"
 #include "sunvo/render/pov.hpp"
@@ -79,6 +80,21 @@ TEST(Scenario, EveryShippedScenarioLoads) {
                         "bench_phoenix_autumn_evening"}) {
     auto s = loadScenario(std::string(SUNVO_SOURCE_DIR) + "/config/scenarios/" + n + ".yaml");
     EXPECT_TRUE(s) << n << ": " << s.status().toString();
+  }
+}
+
+TEST(Scenario, BenchmarkDrivesAreLongerThanOneKilometre) {
+  for (const char* n : {"bench_karlsruhe_summer_noon", "bench_oslo_winter_lowsun",
+                        "bench_phoenix_autumn_evening"}) {
+    auto s = loadScenario(std::string(SUNVO_SOURCE_DIR) + "/config/scenarios/" + n + ".yaml");
+    ASSERT_TRUE(s) << n << ": " << s.status().toString();
+    auto r = generateRoute(generateCity(s->city, s->seed), s->route, s->frames, s->seed);
+    ASSERT_TRUE(r) << n << ": " << r.status().toString();
+    double len = 0;
+    for (std::size_t k = 1; k < r->size(); ++k)
+      len += ((*r)[k].T_enu_b.translation() - (*r)[k - 1].T_enu_b.translation()).norm();
+    std::printf("%s: %d frames, %.0f m\n", n, s->frames, len);
+    EXPECT_GT(len, 1000.0) << n;
   }
 }
 
