@@ -6,7 +6,7 @@ PACKAGES=(
   build-essential cmake ninja-build pkg-config git
   libeigen3-dev libopencv-dev libceres-dev libgeographiclib-dev
   libgpiod-dev libyaml-cpp-dev libgtest-dev libgmock-dev libbenchmark-dev
-  python3 python3-ephem
+  python3 python3-ephem povray
 )
 
 missing=()

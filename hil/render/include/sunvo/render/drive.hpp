@@ -1,0 +1,112 @@
+#pragma once
+// A rendered drive: scenario configuration (YAML), the per-frame sun/sky/lighting, the sensor
+// model applied to POV-Ray's output, and the KITTI raw layout written to disk:
+//   <out>/<date>/calib_cam_to_cam.txt, calib_imu_to_velo.txt, calib_velo_to_cam.txt
+//   <out>/<date>/<date>_drive_<nnnn>_sync/image_0{0,1,2,3}/{timestamps.txt,data/%010d.png}
+//   ..._sync/gt/poses_cam0.txt       KITTI 3x4 T_c0(0)_c0(k) per line (odometry convention)
+//   ..._sync/gt/poses_cam0_enu.txt   3x4 T_enu_c0(k) per line (local ENU at the origin)
+//   ..._sync/gt/sun_cam0.csv         frame,sx,sy,sz (unit sun vector in camera 0, as
+//                                    kitti_odometry/*_sun_cam.csv)
+//   ..._sync/gt/sun_enu.csv          frame,zenith_deg,azimuth_deg,e,n,u (SPA, unrefracted)
+//   ..._sync/gt/origin.txt           latitude_deg longitude_deg altitude_m of the ENU origin
+//   ..._sync/gt/body_enu.csv         frame,utc_ns,e,n,u,roll_rad,pitch_rad,yaw_rad,ve,vn,vu
+//                                    (IMU/body pose for an OXTS writer; see VehicleState)
+//   ..._sync/pov/                    city.inc, frame_%06d.pov, sky_%06d.hdr, povray logs
+
+#include <cstdint>
+#include <functional>
+#include <opencv2/core/mat.hpp>
+#include <random>
+#include <string>
+
+#include "sunvo/core/camera.hpp"
+#include "sunvo/core/time.hpp"
+#include "sunvo/render/perez_sky.hpp"
+#include "sunvo/render/pov.hpp"
+#include "sunvo/render/scene.hpp"
+
+namespace sunvo::render {
+
+struct SensorOptions {
+  double full_well_e =
+      8000.0;  // electrons at saturation (shot noise), [100, 1e6]; 0 = no shot noise
+  double read_noise_e = 12.0;    // read noise std, electrons, [0, 1000]
+  double vignetting = 0.3;       // 0 = none; fraction of the cos^4 fall-off applied, [0, 1]
+  double exposure_sigma = 0.02;  // per-frame log-gain innovation (AR(1), 0.9), [0, 0.5]
+  double exposure_target =
+      0.3;  // linear value of an albedo-0.25 patch under E_sky + E_sun max(cos z_s, 0.5), (0, 1]
+  double motion_blur_px = 0.0;  // horizontal box blur length, px, [0, 20]; 0 = off
+  Status validate() const;
+};
+
+// Written calibration = true calibration perturbed by these (the images use the true one).
+struct CalibErrorOptions {
+  double focal_scale = 1.0;     // [0.9, 1.1]
+  double cu_offset_px = 0.0;    // [-20, 20]
+  double cv_offset_px = 0.0;    // [-20, 20]
+  double baseline_scale = 1.0;  // [0.9, 1.1]
+  Status validate() const;
+};
+
+struct Scenario {
+  std::string name = "drive";
+  int drive_number = 1;        // [0, 9999]
+  double latitude_deg = 49.0;  // ENU origin, WGS84, [-90, 90]
+  double longitude_deg = 8.4;  // [-180, 180]
+  double altitude_m = 115.0;   // [-500, 9000]
+  TimeNs start_utc = 0;        // first frame, UTC
+  int frames = 100;            // [1, 100000]
+  std::uint64_t seed = 1;
+  int sky_image_width = 256;  // equirectangular sky, px (height = width / 2), [32, 4096]
+  SkyOptions sky;
+  CityOptions city;
+  RouteOptions route;
+  StereoCamera camera{721.5377, 721.5377, 609.5593, 172.854, 0.537, 1242, 375};
+  RenderQuality quality;
+  SensorOptions sensor;
+  CalibErrorOptions calib_error;
+  Status validate() const;
+};
+
+// Reads a scenario YAML (see config/scenarios/). Unknown keys and bad values fail with a
+// message naming the key ("route.speed_max_mps ..."); missing keys keep their defaults.
+Expected<Scenario> loadScenario(const std::string& path);
+Expected<Scenario> parseScenario(const std::string& yaml_text, const std::string& label);
+
+// Fixed KITTI-like extrinsics of the rig (body = IMU frame, x forward, y left, z up, origin on
+// the ground below the IMU): IMU 0.93 m above ground, Velodyne at (0.81, -0.32, 1.73) m,
+// camera 0 at (1.08, -0.32, 1.65) m looking forward (R_b_c: x_c = -y_b, y_c = -z_b, z_c = x_b).
+Isometry3 bodyFromCamera0();
+Isometry3 bodyFromVelodyne();
+
+// Lighting of one frame: sun colour/intensity, ambient and the exposure scale applied to all.
+struct FrameLighting {
+  Lighting pov;
+  double sun_zenith_deg = 0.0, sun_azimuth_deg = 0.0;
+  double exposure_scale = 1.0;  // POV value per cd/m^2
+  double sky_illuminance_lux = 0.0, sun_normal_illuminance_lux = 0.0;
+};
+FrameLighting computeLighting(const Eigen::Vector3d& sun_enu, const SkyOptions& sky,
+                              double exposure_target);
+
+// Applies exposure gain, vignetting, motion blur and noise to a BGR8 image (sRGB-encoded).
+cv::Mat applySensor(const cv::Mat& bgr8, const SensorOptions& o, double gain, double fu, double cu,
+                    double cv_px, std::uint64_t noise_seed);
+
+// Writes the KITTI calibration files into date_dir.
+Status writeKittiCalibration(const std::string& date_dir, const StereoCamera& cam,
+                             const CalibErrorOptions& err);
+
+// "YYYY-MM-DD HH:MM:SS.nnnnnnnnn" (UTC).
+std::string kittiTimestamp(TimeNs t);
+
+struct DriveProgress {
+  std::size_t done = 0, total = 0;
+};
+
+// Renders the whole drive (2 povray renders per frame) with `jobs` parallel povray children.
+// Returns the drive folder.
+Expected<std::string> renderDrive(const Scenario& s, const std::string& out_root, int jobs,
+                                  const std::function<void(const DriveProgress&)>& progress);
+
+}  // namespace sunvo::render

@@ -1,0 +1,545 @@
+#include "sunvo/render/drive.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <set>
+#include <sstream>
+
+#include "sunvo/sun/spa.hpp"
+
+namespace fs = std::filesystem;
+
+namespace sunvo::render {
+namespace {
+constexpr double kPi = std::numbers::pi;
+
+Status range(const std::string& key, const char* r) {
+  return invalidArgument(key + " out of range " + r);
+}
+
+// sRGB transfer function and its inverse (IEC 61966-2-1).
+double srgbToLinear(double c) {
+  return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+}
+double linearToSrgb(double l) {
+  l = std::clamp(l, 0.0, 1.0);
+  return l <= 0.0031308 ? 12.92 * l : 1.055 * std::pow(l, 1.0 / 2.4) - 0.055;
+}
+
+Status writeText(const std::string& path, const std::string& text) {
+  std::ofstream f(path);
+  if (!f) return ioError("cannot write " + path);
+  f << text;
+  if (!f) return ioError("write failed: " + path);
+  return Status::ok();
+}
+
+std::string row3x4(const Isometry3& T) {
+  std::string s;
+  char b[32];
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c) {
+      std::snprintf(b, sizeof b, (r == 0 && c == 0) ? "%.9e" : " %.9e", T.matrix()(r, c));
+      s += b;
+    }
+  s += "\n";
+  return s;
+}
+
+// --- YAML helpers: every key is checked against the allowed set and its value parsed with
+// the key named in the error. yaml-cpp throws; the exceptions stop here.
+struct Reader {
+  std::string label;
+  Status st;
+  void keys(const YAML::Node& n, const std::string& sec, const std::set<std::string>& allowed) {
+    if (!st.isOk() || !n) return;
+    if (!n.IsMap()) {
+      st = invalidArgument(label + ": " + (sec.empty() ? "top level" : sec) + " must be a map");
+      return;
+    }
+    for (const auto& kv : n) {
+      const std::string k = kv.first.as<std::string>();
+      if (allowed.count(k) == 0) {
+        st = invalidArgument(label + ": unknown key '" + (sec.empty() ? k : sec + "." + k) + "'");
+        return;
+      }
+    }
+  }
+  template <typename T>
+  void get(const YAML::Node& n, const std::string& sec, const char* key, T& out) {
+    if (!st.isOk() || !n || !n[key]) return;
+    try {
+      out = n[key].as<T>();
+    } catch (const YAML::Exception&) {
+      st = invalidArgument(label + ": key '" + sec + (sec.empty() ? "" : ".") + key +
+                           "': not a valid value");
+    }
+  }
+};
+}  // namespace
+
+Status SensorOptions::validate() const {
+  if (!(full_well_e == 0.0 || (full_well_e >= 100 && full_well_e <= 1e6)))
+    return range("sensor.full_well_e", "0 or [100, 1e6]");
+  if (!(read_noise_e >= 0 && read_noise_e <= 1000))
+    return range("sensor.read_noise_e", "[0, 1000]");
+  if (!(vignetting >= 0 && vignetting <= 1)) return range("sensor.vignetting", "[0, 1]");
+  if (!(exposure_sigma >= 0 && exposure_sigma <= 0.5))
+    return range("sensor.exposure_sigma", "[0, 0.5]");
+  if (!(exposure_target > 0 && exposure_target <= 1))
+    return range("sensor.exposure_target", "(0, 1]");
+  if (!(motion_blur_px >= 0 && motion_blur_px <= 20))
+    return range("sensor.motion_blur_px", "[0, 20]");
+  return Status::ok();
+}
+
+Status CalibErrorOptions::validate() const {
+  if (!(focal_scale >= 0.9 && focal_scale <= 1.1))
+    return range("calib_error.focal_scale", "[0.9, 1.1]");
+  if (!(cu_offset_px >= -20 && cu_offset_px <= 20))
+    return range("calib_error.cu_offset_px", "[-20, 20]");
+  if (!(cv_offset_px >= -20 && cv_offset_px <= 20))
+    return range("calib_error.cv_offset_px", "[-20, 20]");
+  if (!(baseline_scale >= 0.9 && baseline_scale <= 1.1))
+    return range("calib_error.baseline_scale", "[0.9, 1.1]");
+  return Status::ok();
+}
+
+Status Scenario::validate() const {
+  if (name.empty() || name.find('/') != std::string::npos)
+    return invalidArgument("name: empty or contains '/'");
+  if (!(drive_number >= 0 && drive_number <= 9999)) return range("drive_number", "[0, 9999]");
+  if (!(latitude_deg >= -90 && latitude_deg <= 90)) return range("place.latitude_deg", "[-90, 90]");
+  if (!(longitude_deg >= -180 && longitude_deg <= 180))
+    return range("place.longitude_deg", "[-180, 180]");
+  if (!(altitude_m >= -500 && altitude_m <= 9000)) return range("place.altitude_m", "[-500, 9000]");
+  if (!(frames >= 1 && frames <= 100000)) return range("frames", "[1, 100000]");
+  if (!(sky_image_width >= 32 && sky_image_width <= 4096))
+    return range("sky.image_width", "[32, 4096]");
+  SUNVO_RETURN_IF_ERROR(sky.validate());
+  SUNVO_RETURN_IF_ERROR(city.validate());
+  SUNVO_RETURN_IF_ERROR(route.validate());
+  if (auto st = camera.validate(); !st.isOk()) return invalidArgument("camera: " + st.message());
+  SUNVO_RETURN_IF_ERROR(quality.validate());
+  SUNVO_RETURN_IF_ERROR(sensor.validate());
+  SUNVO_RETURN_IF_ERROR(calib_error.validate());
+  return Status::ok();
+}
+
+Expected<Scenario> parseScenario(const std::string& text, const std::string& label) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    return parseError(label + ": YAML: " + e.what());
+  }
+  Scenario s;
+  Reader r{label, {}};
+  try {
+    r.keys(root, "",
+           {"name", "drive_number", "place", "start_utc", "frames", "seed", "sky", "city", "route",
+            "camera", "render", "sensor", "calib_error"});
+    r.get(root, "", "name", s.name);
+    r.get(root, "", "drive_number", s.drive_number);
+    r.get(root, "", "frames", s.frames);
+    r.get(root, "", "seed", s.seed);
+    std::string start = "2011-09-26 13:00:00";
+    r.get(root, "", "start_utc", start);
+    if (r.st.isOk()) {
+      auto t = parseCivilTime(start, 0);
+      if (!t) return invalidArgument(label + ": key 'start_utc': " + t.status().message());
+      s.start_utc = *t;
+    }
+    const YAML::Node place = root["place"];
+    r.keys(place, "place", {"latitude_deg", "longitude_deg", "altitude_m"});
+    r.get(place, "place", "latitude_deg", s.latitude_deg);
+    r.get(place, "place", "longitude_deg", s.longitude_deg);
+    r.get(place, "place", "altitude_m", s.altitude_m);
+    const YAML::Node sky = root["sky"];
+    r.keys(sky, "sky", {"turbidity", "image_width"});
+    r.get(sky, "sky", "turbidity", s.sky.turbidity);
+    r.get(sky, "sky", "image_width", s.sky_image_width);
+    const YAML::Node c = root["city"];
+    r.keys(c, "city",
+           {"blocks_x", "blocks_y", "block_size_m", "street_width_m", "sidewalk_width_m",
+            "min_height_m", "max_height_m", "min_lot_m", "max_lot_m", "pole_spacing_m",
+            "tree_probability", "parked_car_probability"});
+    r.get(c, "city", "blocks_x", s.city.blocks_x);
+    r.get(c, "city", "blocks_y", s.city.blocks_y);
+    r.get(c, "city", "block_size_m", s.city.block_size_m);
+    r.get(c, "city", "street_width_m", s.city.street_width_m);
+    r.get(c, "city", "sidewalk_width_m", s.city.sidewalk_width_m);
+    r.get(c, "city", "min_height_m", s.city.min_height_m);
+    r.get(c, "city", "max_height_m", s.city.max_height_m);
+    r.get(c, "city", "min_lot_m", s.city.min_lot_m);
+    r.get(c, "city", "max_lot_m", s.city.max_lot_m);
+    r.get(c, "city", "pole_spacing_m", s.city.pole_spacing_m);
+    r.get(c, "city", "tree_probability", s.city.tree_probability);
+    r.get(c, "city", "parked_car_probability", s.city.parked_car_probability);
+    const YAML::Node ro = root["route"];
+    r.keys(ro, "route",
+           {"speed_min_mps", "speed_max_mps", "max_lateral_accel_mps2", "max_long_accel_mps2",
+            "turn_probability", "turn_radius_m", "lane_offset_m", "rate_hz", "pitch_amplitude_deg",
+            "roll_amplitude_deg", "roll_per_lateral_accel_deg", "pitch_per_long_accel_deg"});
+    r.get(ro, "route", "speed_min_mps", s.route.speed_min_mps);
+    r.get(ro, "route", "speed_max_mps", s.route.speed_max_mps);
+    r.get(ro, "route", "max_lateral_accel_mps2", s.route.max_lateral_accel_mps2);
+    r.get(ro, "route", "max_long_accel_mps2", s.route.max_long_accel_mps2);
+    r.get(ro, "route", "turn_probability", s.route.turn_probability);
+    r.get(ro, "route", "turn_radius_m", s.route.turn_radius_m);
+    r.get(ro, "route", "lane_offset_m", s.route.lane_offset_m);
+    r.get(ro, "route", "rate_hz", s.route.rate_hz);
+    r.get(ro, "route", "pitch_amplitude_deg", s.route.pitch_amplitude_deg);
+    r.get(ro, "route", "roll_amplitude_deg", s.route.roll_amplitude_deg);
+    r.get(ro, "route", "roll_per_lateral_accel_deg", s.route.roll_per_lateral_accel_deg);
+    r.get(ro, "route", "pitch_per_long_accel_deg", s.route.pitch_per_long_accel_deg);
+    const YAML::Node cam = root["camera"];
+    r.keys(cam, "camera", {"fu", "fv", "cu", "cv", "baseline_m", "width", "height"});
+    r.get(cam, "camera", "fu", s.camera.fu);
+    r.get(cam, "camera", "fv", s.camera.fv);
+    r.get(cam, "camera", "cu", s.camera.cu);
+    r.get(cam, "camera", "cv", s.camera.cv);
+    r.get(cam, "camera", "baseline_m", s.camera.baseline_m);
+    r.get(cam, "camera", "width", s.camera.width);
+    r.get(cam, "camera", "height", s.camera.height);
+    const YAML::Node q = root["render"];
+    r.keys(q, "render", {"antialias_threshold", "antialias_depth", "quality"});
+    r.get(q, "render", "antialias_threshold", s.quality.antialias_threshold);
+    r.get(q, "render", "antialias_depth", s.quality.antialias_depth);
+    r.get(q, "render", "quality", s.quality.quality);
+    const YAML::Node se = root["sensor"];
+    r.keys(se, "sensor",
+           {"full_well_e", "read_noise_e", "vignetting", "exposure_sigma", "exposure_target",
+            "motion_blur_px"});
+    r.get(se, "sensor", "full_well_e", s.sensor.full_well_e);
+    r.get(se, "sensor", "read_noise_e", s.sensor.read_noise_e);
+    r.get(se, "sensor", "vignetting", s.sensor.vignetting);
+    r.get(se, "sensor", "exposure_sigma", s.sensor.exposure_sigma);
+    r.get(se, "sensor", "exposure_target", s.sensor.exposure_target);
+    r.get(se, "sensor", "motion_blur_px", s.sensor.motion_blur_px);
+    const YAML::Node ce = root["calib_error"];
+    r.keys(ce, "calib_error", {"focal_scale", "cu_offset_px", "cv_offset_px", "baseline_scale"});
+    r.get(ce, "calib_error", "focal_scale", s.calib_error.focal_scale);
+    r.get(ce, "calib_error", "cu_offset_px", s.calib_error.cu_offset_px);
+    r.get(ce, "calib_error", "cv_offset_px", s.calib_error.cv_offset_px);
+    r.get(ce, "calib_error", "baseline_scale", s.calib_error.baseline_scale);
+  } catch (const YAML::Exception& e) {
+    return parseError(label + ": YAML: " + e.what());
+  }
+  SUNVO_RETURN_IF_ERROR(r.st);
+  if (auto st = s.validate(); !st.isOk()) return invalidArgument(label + ": " + st.message());
+  return s;
+}
+
+Expected<Scenario> loadScenario(const std::string& path) {
+  std::ifstream f(path);
+  if (!f) return notFound("cannot open scenario " + path);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return parseScenario(ss.str(), path);
+}
+
+Isometry3 bodyFromCamera0() {
+  Isometry3 T = Isometry3::Identity();
+  T.linear() << 0, 0, 1, -1, 0, 0, 0, -1, 0;  // columns: x_c = -y_b, y_c = -z_b, z_c = x_b
+  T.translation() = Eigen::Vector3d(1.08, -0.32, 1.65);
+  return T;
+}
+
+Isometry3 bodyFromVelodyne() {
+  Isometry3 T = Isometry3::Identity();
+  T.translation() = Eigen::Vector3d(0.81, -0.32, 1.73);
+  return T;
+}
+
+FrameLighting computeLighting(const Eigen::Vector3d& sun_enu, const SkyOptions& sky,
+                              double exposure_target) {
+  FrameLighting f;
+  const PerezSky model(sun_enu, sky);
+  const double zs = std::acos(std::clamp(sun_enu.normalized().z(), -1.0, 1.0));
+  Eigen::Vector3d E_sky_rgb;
+  f.sky_illuminance_lux = model.horizontalIlluminanceLux(&E_sky_rgb);
+  f.sun_normal_illuminance_lux = directSunIlluminanceLux(zs, sky.turbidity);
+  // Auto-exposure: a Lambertian patch of albedo rho has radiance rho E / pi; the scale k makes
+  // an albedo-0.25 patch lit by the sky and by the sun at an incidence of at most 60 deg
+  // (E_ref = E_sky + E_sun max(cos z_s, 0.5)) read exposure_target (linear). The 60 deg floor
+  // keeps a low sun from driving the exposure up until the sky saturates (facades facing a low
+  // sun are lit almost normally).
+  const double E_ref =
+      f.sun_normal_illuminance_lux * std::max(std::cos(zs), 0.5) + f.sky_illuminance_lux;
+  f.exposure_scale = exposure_target * kPi / (0.25 * std::max(E_ref, 1.0));
+  // POV: colour = pigment (ambient_light + light cos); pigment = albedo rho, so the light colour
+  // is k E_sun / pi and ambient k E_sky / pi. The ambient is the horizontal sky illuminance
+  // times 0.8 (vertical faces see half the sky plus ground bounce; no radiosity).
+  f.pov.sun_enu = sun_enu.normalized();
+  f.pov.sun_rgb =
+      f.exposure_scale * f.sun_normal_illuminance_lux / kPi * sunColour(zs, sky.turbidity);
+  f.pov.ambient_rgb = 0.8 * f.exposure_scale * E_sky_rgb / kPi;
+  f.sun_zenith_deg = zs * 180.0 / kPi;
+  return f;
+}
+
+cv::Mat applySensor(const cv::Mat& bgr8, const SensorOptions& o, double gain, double fu, double cu,
+                    double cv_px, std::uint64_t noise_seed) {
+  cv::Mat lin(bgr8.size(), CV_32FC3);
+  float lut[256];
+  for (int i = 0; i < 256; ++i) lut[i] = static_cast<float>(srgbToLinear(i / 255.0));
+  for (int y = 0; y < bgr8.rows; ++y)
+    for (int x = 0; x < bgr8.cols; ++x) {
+      const cv::Vec3b p = bgr8.at<cv::Vec3b>(y, x);
+      lin.at<cv::Vec3f>(y, x) = cv::Vec3f(lut[p[0]], lut[p[1]], lut[p[2]]);
+    }
+  if (o.motion_blur_px >= 1.0) {
+    const int k = static_cast<int>(std::lround(o.motion_blur_px));
+    cv::blur(lin, lin, cv::Size(k, 1));
+  }
+  std::mt19937_64 rng(noise_seed);
+  std::normal_distribution<float> N01(0.0f, 1.0f);
+  cv::Mat out(bgr8.size(), CV_8UC3);
+  const double fw = o.full_well_e > 0 ? o.full_well_e : 8000.0;
+  for (int y = 0; y < bgr8.rows; ++y)
+    for (int x = 0; x < bgr8.cols; ++x) {
+      // Natural vignetting cos^4(angle off axis), applied with strength o.vignetting.
+      const double r2 = ((x - cu) * (x - cu) + (y - cv_px) * (y - cv_px)) / (fu * fu);
+      const double c4 = 1.0 / ((1.0 + r2) * (1.0 + r2));
+      const double v = gain * (1.0 - o.vignetting * (1.0 - c4));
+      cv::Vec3b& q = out.at<cv::Vec3b>(y, x);
+      const cv::Vec3f p = lin.at<cv::Vec3f>(y, x);
+      for (int c = 0; c < 3; ++c) {
+        // Electrons e = fw * signal; shot noise sqrt(e), read noise sigma_r (Gaussian approx.).
+        const double e = fw * std::min(static_cast<double>(p[c]) * v, 1.2);
+        const double sigma =
+            std::sqrt((o.full_well_e > 0 ? e : 0.0) + o.read_noise_e * o.read_noise_e);
+        const double s = (e + sigma * static_cast<double>(N01(rng))) / fw;
+        q[c] = static_cast<unsigned char>(std::lround(255.0 * linearToSrgb(s)));
+      }
+    }
+  return out;
+}
+
+Status writeKittiCalibration(const std::string& dir, const StereoCamera& cam,
+                             const CalibErrorOptions& err) {
+  const double f_u = cam.fu * err.focal_scale, f_v = cam.fv * err.focal_scale;
+  const double cu = cam.cu + err.cu_offset_px, cvv = cam.cv + err.cv_offset_px;
+  const double b = cam.baseline_m * err.baseline_scale;
+  char buf[512];
+  std::string s = "calib_time: 01-Jan-2026 00:00:00\ncorner_dist: 9.950000e-02\n";
+  for (int i = 0; i < 4; ++i) {
+    // Cameras 2/3 (colour) are rendered from the same centres as 0/1 (documented).
+    const double bi = (i == 1 || i == 3) ? b : 0.0;
+    std::snprintf(buf, sizeof buf, "S_%02d: %.6e %.6e\n", i, static_cast<double>(cam.width),
+                  static_cast<double>(cam.height));
+    s += buf;
+    std::snprintf(buf, sizeof buf,
+                  "K_%02d: %.6e 0.000000e+00 %.6e 0.000000e+00 %.6e %.6e 0.000000e+00 0.000000e+00 "
+                  "1.000000e+00\n",
+                  i, f_u, cu, f_v, cvv);
+    s += buf;
+    std::snprintf(buf, sizeof buf,
+                  "D_%02d: 0.000000e+00 0.000000e+00 0.000000e+00 0.000000e+00 0.000000e+00\n", i);
+    s += buf;
+    std::snprintf(buf, sizeof buf,
+                  "R_%02d: 1.000000e+00 0.000000e+00 0.000000e+00 0.000000e+00 1.000000e+00 "
+                  "0.000000e+00 0.000000e+00 0.000000e+00 1.000000e+00\n",
+                  i);
+    s += buf;
+    std::snprintf(buf, sizeof buf, "T_%02d: %.6e 0.000000e+00 0.000000e+00\n", i, -bi);
+    s += buf;
+    std::snprintf(buf, sizeof buf, "S_rect_%02d: %.6e %.6e\n", i, static_cast<double>(cam.width),
+                  static_cast<double>(cam.height));
+    s += buf;
+    std::snprintf(buf, sizeof buf,
+                  "R_rect_%02d: 1.000000e+00 0.000000e+00 0.000000e+00 0.000000e+00 1.000000e+00 "
+                  "0.000000e+00 0.000000e+00 0.000000e+00 1.000000e+00\n",
+                  i);
+    s += buf;
+    std::snprintf(buf, sizeof buf,
+                  "P_rect_%02d: %.6e 0.000000e+00 %.6e %.6e 0.000000e+00 %.6e %.6e 0.000000e+00 "
+                  "0.000000e+00 0.000000e+00 1.000000e+00 0.000000e+00\n",
+                  i, f_u, cu, -f_u * bi, f_v, cvv);
+    s += buf;
+  }
+  SUNVO_RETURN_IF_ERROR(writeText(dir + "/calib_cam_to_cam.txt", s));
+  // calib_imu_to_velo: p_velo = R p_imu + T; IMU frame = body frame shifted to the IMU
+  // (0.93 m above ground), axes equal.
+  const Isometry3 T_b_v = bodyFromVelodyne(), T_b_c = bodyFromCamera0();
+  Isometry3 T_b_imu = Isometry3::Identity();
+  T_b_imu.translation() = Eigen::Vector3d(0, 0, 0.93);
+  auto rt = [](const Isometry3& T) {
+    std::string o = "R:";
+    char b2[32];
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) {
+        std::snprintf(b2, sizeof b2, " %.6e", T.linear()(r, c));
+        o += b2;
+      }
+    o += "\nT:";
+    for (int r = 0; r < 3; ++r) {
+      std::snprintf(b2, sizeof b2, " %.6e", T.translation()(r));
+      o += b2;
+    }
+    return o + "\n";
+  };
+  SUNVO_RETURN_IF_ERROR(
+      writeText(dir + "/calib_imu_to_velo.txt",
+                "calib_time: 01-Jan-2026 00:00:00\n" + rt(T_b_v.inverse() * T_b_imu)));
+  SUNVO_RETURN_IF_ERROR(
+      writeText(dir + "/calib_velo_to_cam.txt",
+                "calib_time: 01-Jan-2026 00:00:00\n" + rt(T_b_c.inverse() * T_b_v) +
+                    "delta_f: 0.000000e+00 0.000000e+00\ndelta_c: 0.000000e+00 0.000000e+00\n"));
+  return Status::ok();
+}
+
+std::string kittiTimestamp(TimeNs t) {
+  std::string s = formatUtcIso(t);  // YYYY-MM-DDTHH:MM:SS.fffffffffZ
+  if (!s.empty() && s.back() == 'Z') s.pop_back();
+  if (s.size() > 10 && s[10] == 'T') s[10] = ' ';
+  return s;
+}
+
+Expected<std::string> renderDrive(const Scenario& s, const std::string& out_root, int jobs,
+                                  const std::function<void(const DriveProgress&)>& progress) {
+  SUNVO_RETURN_IF_ERROR(s.validate());
+  const City city = generateCity(s.city, s.seed);
+  auto route = generateRoute(city, s.route, s.frames, s.seed);
+  if (!route) return route.status();
+  const std::string iso = formatUtcIso(s.start_utc);
+  const std::string date = iso.substr(0, 4) + "_" + iso.substr(5, 2) + "_" + iso.substr(8, 2);
+  char drive_name[64];
+  std::snprintf(drive_name, sizeof drive_name, "_drive_%04d_sync", s.drive_number);
+  const std::string date_dir = out_root + "/" + date;
+  const std::string drive_dir = date_dir + "/" + date + drive_name;
+  const std::string pov_dir = drive_dir + "/pov", gt_dir = drive_dir + "/gt";
+  std::error_code ec;
+  for (int c = 0; c < 4; ++c)
+    fs::create_directories(drive_dir + "/image_0" + std::to_string(c) + "/data", ec);
+  fs::create_directories(pov_dir, ec);
+  fs::create_directories(gt_dir, ec);
+  if (ec) return ioError("cannot create " + drive_dir + ": " + ec.message());
+  SUNVO_RETURN_IF_ERROR(writeKittiCalibration(date_dir, s.camera, s.calib_error));
+  SUNVO_RETURN_IF_ERROR(writeText(pov_dir + "/city.inc", povSceneBody(city.scene)));
+
+  sun::SpaOptions spa;
+  spa.latitude_deg = s.latitude_deg;
+  spa.longitude_deg = s.longitude_deg;
+  spa.elevation_m = s.altitude_m;
+  const Isometry3 T_b_c0 = bodyFromCamera0();
+  Isometry3 T_c0_c1 = Isometry3::Identity();
+  T_c0_c1.translation() = Eigen::Vector3d(s.camera.baseline_m, 0, 0);
+  const TimeNs dt_ns = static_cast<TimeNs>(std::llround(1e9 / s.route.rate_hz));
+  std::string ts, poses, poses_enu,
+      sun_c_csv = "frame,sx,sy,sz\n", sun_enu_csv = "frame,zenith_deg,azimuth_deg,e,n,u\n",
+      body_csv = "frame,utc_ns,e,n,u,roll_rad,pitch_rad,yaw_rad,ve,vn,vu\n";
+  std::vector<RenderJob> render_jobs;
+  std::vector<double> gains;
+  std::mt19937_64 exp_rng(s.seed * 7919 + 17);
+  std::normal_distribution<double> N01(0.0, 1.0);
+  double log_gain = 0.0;
+  Isometry3 T_enu_c0_first = Isometry3::Identity();
+  char buf[256];
+  for (int k = 0; k < s.frames; ++k) {
+    const VehicleState& vs = (*route)[static_cast<std::size_t>(k)];
+    const TimeNs t = s.start_utc + k * dt_ns;
+    auto sp = sun::computeSolarPosition(t, spa);
+    if (!sp) return sp.status();
+    const Isometry3 T_enu_c0 = vs.T_enu_b * T_b_c0;
+    const Isometry3 T_enu_c1 = T_enu_c0 * T_c0_c1;
+    if (k == 0) T_enu_c0_first = T_enu_c0;
+    FrameLighting fl = computeLighting(sp->sun_enu, s.sky, s.sensor.exposure_target);
+    char name[64];
+    std::snprintf(name, sizeof name, "sky_%06d.hdr", k);
+    fl.pov.sky_image = name;
+    const PerezSky sky(sp->sun_enu, s.sky);
+    const cv::Mat sky_img =
+        sky.equirectangular(s.sky_image_width, s.sky_image_width / 2, fl.exposure_scale,
+                            Eigen::Vector3d(1500, 1500, 1500));
+    if (!cv::imwrite(pov_dir + "/" + name, sky_img))
+      return ioError("cannot write sky image " + std::string(name));
+    std::snprintf(name, sizeof name, "frame_%06d.pov", k);
+    SUNVO_RETURN_IF_ERROR(writeText(
+        pov_dir + "/" + name,
+        povFrame({s.camera, s.camera}, {T_enu_c0, T_enu_c1}, fl.pov, "city.inc", nullptr)));
+    for (int c = 0; c < 2; ++c) {
+      RenderJob j;
+      j.work_dir = pov_dir;
+      j.pov_file = name;
+      char out[64];
+      std::snprintf(out, sizeof out, "raw_%06d_%d.png", k, c);
+      j.output_png = out;
+      j.log_file = std::string(out) + ".log";
+      j.width = s.camera.width;
+      j.height = s.camera.height;
+      j.cam_index = c;
+      render_jobs.push_back(j);
+    }
+    if (k > 0) log_gain = 0.9 * log_gain + s.sensor.exposure_sigma * N01(exp_rng);
+    gains.push_back(std::exp(log_gain));
+    ts += kittiTimestamp(t) + "\n";
+    poses += row3x4(T_enu_c0_first.inverse() * T_enu_c0);
+    poses_enu += row3x4(T_enu_c0);
+    const Eigen::Vector3d sun_c = T_enu_c0.linear().transpose() * sp->sun_enu;
+    std::snprintf(buf, sizeof buf, "%d,%.6f,%.6f,%.6f\n", k, sun_c.x(), sun_c.y(), sun_c.z());
+    sun_c_csv += buf;
+    std::snprintf(buf, sizeof buf, "%d,%.6f,%.6f,%.6f,%.6f,%.6f\n", k, sp->zenith_deg,
+                  sp->azimuth_deg, sp->sun_enu.x(), sp->sun_enu.y(), sp->sun_enu.z());
+    sun_enu_csv += buf;
+    const Eigen::Vector3d p_imu = vs.T_enu_b * Eigen::Vector3d(0, 0, 0.93);
+    std::snprintf(buf, sizeof buf, "%d,%lld,%.4f,%.4f,%.4f,%.7f,%.7f,%.7f,%.4f,%.4f,%.4f\n", k,
+                  static_cast<long long>(t), p_imu.x(), p_imu.y(), p_imu.z(), vs.roll_rad,
+                  vs.pitch_rad, vs.yaw_rad, vs.v_enu.x(), vs.v_enu.y(), vs.v_enu.z());
+    body_csv += buf;
+  }
+  for (int c = 0; c < 4; ++c)
+    SUNVO_RETURN_IF_ERROR(
+        writeText(drive_dir + "/image_0" + std::to_string(c) + "/timestamps.txt", ts));
+  SUNVO_RETURN_IF_ERROR(writeText(gt_dir + "/poses_cam0.txt", poses));
+  SUNVO_RETURN_IF_ERROR(writeText(gt_dir + "/poses_cam0_enu.txt", poses_enu));
+  SUNVO_RETURN_IF_ERROR(writeText(gt_dir + "/sun_cam0.csv", sun_c_csv));
+  SUNVO_RETURN_IF_ERROR(writeText(gt_dir + "/sun_enu.csv", sun_enu_csv));
+  SUNVO_RETURN_IF_ERROR(writeText(gt_dir + "/body_enu.csv", body_csv));
+  std::snprintf(buf, sizeof buf, "%.9f %.9f %.3f\n", s.latitude_deg, s.longitude_deg, s.altitude_m);
+  SUNVO_RETURN_IF_ERROR(writeText(gt_dir + "/origin.txt", buf));
+
+  DriveProgress prog{0, render_jobs.size()};
+  Status post;
+  const Status st =
+      runPovrayJobs(render_jobs, s.quality, jobs, [&](std::size_t i, const Status& js) {
+        ++prog.done;
+        if (js.isOk() && post.isOk()) {
+          const RenderJob& j = render_jobs[i];
+          const int k = static_cast<int>(i / 2), c = static_cast<int>(i % 2);
+          const std::string raw = j.work_dir + "/" + j.output_png;
+          const cv::Mat img = cv::imread(raw, cv::IMREAD_COLOR);
+          if (img.empty()) {
+            post = ioError("cannot read povray output " + raw);
+          } else {
+            const cv::Mat sens = applySensor(
+                img, s.sensor, gains[static_cast<std::size_t>(k)], s.camera.fu, s.camera.cu,
+                s.camera.cv, s.seed * 1000003ULL + static_cast<std::uint64_t>(2 * k + c));
+            cv::Mat gray;
+            cv::cvtColor(sens, gray, cv::COLOR_BGR2GRAY);
+            char fn[32];
+            std::snprintf(fn, sizeof fn, "/data/%010d.png", k);
+            if (!cv::imwrite(drive_dir + "/image_0" + std::to_string(c) + fn, gray) ||
+                !cv::imwrite(drive_dir + "/image_0" + std::to_string(c + 2) + fn, sens)) {
+              post = ioError("cannot write images of frame " + std::to_string(k));
+            }
+            fs::remove(raw, ec);
+          }
+        }
+        if (progress) progress(prog);
+      });
+  SUNVO_RETURN_IF_ERROR(st);
+  SUNVO_RETURN_IF_ERROR(post);
+  return drive_dir;
+}
+
+}  // namespace sunvo::render
