@@ -13,6 +13,9 @@
 #include <set>
 #include <sstream>
 
+#include "sunvo/kitti/oxts.hpp"
+#include "sunvo/kitti/timestamps.hpp"
+#include "sunvo/render/oxts_writer.hpp"
 #include "sunvo/sun/spa.hpp"
 
 namespace fs = std::filesystem;
@@ -444,6 +447,12 @@ Expected<std::string> renderDrive(const Scenario& s, const std::string& out_root
   std::normal_distribution<double> N01(0.0, 1.0);
   double log_gain = 0.0;
   Isometry3 T_enu_c0_first = Isometry3::Identity();
+  // The IMU: the body frame shifted 0.93 m up, axes equal (as calib_imu_to_velo.txt says).
+  Isometry3 T_b_imu = Isometry3::Identity();
+  T_b_imu.translation() = Eigen::Vector3d(0, 0, 0.93);
+  std::vector<Isometry3> T_enu_imu_all;
+  std::vector<Eigen::Vector3d> v_enu_all;
+  std::vector<TimeNs> times_all;
   char buf[256];
   for (int k = 0; k < s.frames; ++k) {
     const VehicleState& vs = (*route)[static_cast<std::size_t>(k)];
@@ -492,6 +501,9 @@ Expected<std::string> renderDrive(const Scenario& s, const std::string& out_root
                   sp->azimuth_deg, sp->sun_enu.x(), sp->sun_enu.y(), sp->sun_enu.z());
     sun_enu_csv += buf;
     const Eigen::Vector3d p_imu = vs.T_enu_b * Eigen::Vector3d(0, 0, 0.93);
+    T_enu_imu_all.push_back(vs.T_enu_b * T_b_imu);
+    v_enu_all.push_back(vs.v_enu);
+    times_all.push_back(t);
     std::snprintf(buf, sizeof buf, "%d,%lld,%.4f,%.4f,%.4f,%.7f,%.7f,%.7f,%.4f,%.4f,%.4f\n", k,
                   static_cast<long long>(t), p_imu.x(), p_imu.y(), p_imu.z(), vs.roll_rad,
                   vs.pitch_rad, vs.yaw_rad, vs.v_enu.x(), vs.v_enu.y(), vs.v_enu.z());
@@ -507,6 +519,20 @@ Expected<std::string> renderDrive(const Scenario& s, const std::string& out_root
   SUNVO_RETURN_IF_ERROR(writeText(gt_dir + "/body_enu.csv", body_csv));
   std::snprintf(buf, sizeof buf, "%.9f %.9f %.3f\n", s.latitude_deg, s.longitude_deg, s.altitude_m);
   SUNVO_RETURN_IF_ERROR(writeText(gt_dir + "/origin.txt", buf));
+  // OXTS records, as the GPS/INS of a KITTI drive would write them (times in UTC).
+  {
+    const geodesy::GeodeticPoint origin{s.latitude_deg, s.longitude_deg, s.altitude_m};
+    auto records =
+        oxtsFromEnuPoses(origin, T_enu_imu_all, v_enu_all, static_cast<double>(dt_ns) * 1e-9);
+    if (!records) return records.status();
+    std::filesystem::create_directories(drive_dir + "/oxts/data");
+    for (std::size_t k = 0; k < records->size(); ++k) {
+      SUNVO_RETURN_IF_ERROR(kitti::writeOxtsRecord(
+          kitti::oxtsRecordPath(drive_dir, static_cast<std::int64_t>(k)), (*records)[k]));
+    }
+    SUNVO_RETURN_IF_ERROR(
+        kitti::writeRawTimestamps(drive_dir + "/oxts/timestamps.txt", times_all, 0));
+  }
 
   DriveProgress prog{0, render_jobs.size()};
   Status post;
