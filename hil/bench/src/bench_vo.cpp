@@ -10,8 +10,13 @@
 // back end of the second run makes the same association + RANSAC calls: its allocations are
 // RANSAC's, and the window's are the full run's back-end allocations minus those.
 //
-// Usage: sunvo_bench_vo [--frames=N] [--warmup=N] [--data=DIR] [--cpu=K] [benchmark flags]
-//   --cpu=K pins the process to CPU K (sched_setaffinity) before anything runs.
+// A third run times the back end alone (vo::StereoOdometry, track mode) on the real feature tracks
+// of KITTI 2011_09_30_drive_0020 (1000 frames, SURF+KLT tracks, ~65 observations per frame).
+//
+// Usage: sunvo_bench_vo [--frames=N] [--warmup=N] [--data=DIR] [--tracks=DIR|--tracks=]
+//                       [--cpu=K] [benchmark flags]
+//   --cpu=K pins the process to CPU K (sched_setaffinity) before anything runs;
+//   --tracks= (empty) skips the track-mode run.
 
 #include <benchmark/benchmark.h>
 
@@ -26,6 +31,7 @@
 
 #include "sunvo/bench/alloc_counter.hpp"
 #include "sunvo/bench/bench_support.hpp"
+#include "sunvo/files/tracks_io.hpp"
 #include "sunvo/pipeline/stereo_visual_odometry.hpp"
 
 namespace {
@@ -39,6 +45,7 @@ struct Config {
   int frames = 500;
   int warmup = 20;
   std::string data = std::string(SUNVO_DATA_DIR) + "/kitti_odometry/00_first_frames";
+  std::string tracks = std::string(SUNVO_DATA_DIR) + "/kitti_tracks/2011_09_30_drive_0020";
   int cpu = -1;  // pin to this CPU when >= 0
 };
 
@@ -46,8 +53,9 @@ struct Run {
   const char* name = "";
   std::vector<double> detect_ms, match_ms, frontend_ms, ransac_ms, window_ms, odometry_ms, total_ms,
       outer_ms, cpu_ms;
+  std::vector<double> ceres_ms;  // Ceres' own total_time of the window solve
   std::vector<double> alloc_frontend, alloc_odometry;
-  std::vector<double> features, tracked, inliers;
+  std::vector<double> features, tracked, inliers, landmarks, iterations;
   int lost = 0;
   int tracking = 0;
   int recovered = 0;
@@ -60,6 +68,8 @@ Config g_config;
 sunvo::bench::KittiFrames g_data;
 Run g_full;
 Run g_ransac_only;
+Run g_tracks;
+sunvo::files::TrackSequence g_track_seq;
 
 void runPipeline(benchmark::State& state, bool use_window, Run& r) {
   sunvo::pipeline::PipelineOptions opt;
@@ -91,9 +101,10 @@ void runPipeline(benchmark::State& state, bool use_window, Run& r) {
     }
   }
   const auto frames = static_cast<std::size_t>(g_config.frames);
-  for (auto* v : {&r.detect_ms, &r.match_ms, &r.frontend_ms, &r.ransac_ms, &r.window_ms,
-                  &r.odometry_ms, &r.total_ms, &r.outer_ms, &r.cpu_ms, &r.alloc_frontend,
-                  &r.alloc_odometry, &r.features, &r.tracked, &r.inliers}) {
+  for (auto* v :
+       {&r.detect_ms, &r.match_ms, &r.frontend_ms, &r.ransac_ms, &r.window_ms, &r.odometry_ms,
+        &r.total_ms, &r.outer_ms, &r.cpu_ms, &r.ceres_ms, &r.alloc_frontend, &r.alloc_odometry,
+        &r.features, &r.tracked, &r.inliers, &r.landmarks, &r.iterations}) {
     v->clear();
     v->reserve(frames);
   }
@@ -125,6 +136,9 @@ void runPipeline(benchmark::State& state, bool use_window, Run& r) {
     r.features.push_back(f.num_features);
     r.tracked.push_back(f.frontend.tracks_kept);
     r.inliers.push_back(f.vo.ransac_inliers);
+    r.ceres_ms.push_back(f.vo.solver_time_s * 1e3);
+    r.landmarks.push_back(f.vo.window_landmarks);
+    r.iterations.push_back(f.vo.solver_iterations);
     switch (f.vo.status) {
       case sunvo::vo::TrackingStatus::kLost:
         ++r.lost;
@@ -147,6 +161,54 @@ void runPipeline(benchmark::State& state, bool use_window, Run& r) {
   state.counters["total_ms_p50"] = percentile(r.total_ms, 0.5);
   state.counters["total_ms_p99"] = percentile(r.total_ms, 0.99);
   state.counters["lost"] = r.lost;
+  r.ok = true;
+}
+
+// The back end alone on recorded real tracks: every frame of the sequence once, in order.
+void benchTracks(benchmark::State& state) {
+  Run& r = g_tracks;
+  sunvo::vo::StereoOdometry vo;
+  const sunvo::Status st =
+      vo.init(sunvo::vo::VoOptions{}, g_track_seq.camera, sunvo::Isometry3::Identity());
+  if (!st.isOk()) {
+    state.SkipWithError(st.toString().c_str());
+    return;
+  }
+  r.rss_warm_kb = sunvo::bench::procStatusKb("VmRSS:");
+  std::size_t k = 0;
+  bool failed = false;
+  for (auto _ : state) {
+    const std::uint64_t a0 = sunvo::bench::allocationCount();
+    const double cpu0 = sunvo::bench::threadCpuMs();
+    const auto t0 = std::chrono::steady_clock::now();
+    auto res = vo.process(g_track_seq.frames[k]);
+    const auto t1 = std::chrono::steady_clock::now();
+    const double cpu1 = sunvo::bench::threadCpuMs();
+    const std::uint64_t a1 = sunvo::bench::allocationCount();
+    ++k;
+    if (!res.hasValue()) {
+      failed = true;
+      continue;
+    }
+    if (k == 1) continue;  // frame 0 only initialises
+    r.ransac_ms.push_back(res->ransac_ms);
+    r.window_ms.push_back(res->window_ms);
+    r.ceres_ms.push_back(res->solver_time_s * 1e3);
+    r.odometry_ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+    r.cpu_ms.push_back(cpu1 - cpu0);
+    r.alloc_odometry.push_back(static_cast<double>(a1 - a0));
+    r.inliers.push_back(res->ransac_inliers);
+    r.landmarks.push_back(res->window_landmarks);
+    r.iterations.push_back(res->solver_iterations);
+    if (res->status == sunvo::vo::TrackingStatus::kLost) ++r.lost;
+    if (res->status == sunvo::vo::TrackingStatus::kRecovered) ++r.recovered;
+    if (res->status == sunvo::vo::TrackingStatus::kTracking) ++r.tracking;
+  }
+  r.rss_end_kb = sunvo::bench::procStatusKb("VmRSS:");
+  if (failed) {
+    state.SkipWithError("process failed");
+    return;
+  }
   r.ok = true;
 }
 
@@ -180,6 +242,7 @@ void printRun(const Run& r) {
   row("front end: process() total", r.frontend_ms);
   row("back end: association + RANSAC", r.ransac_ms);
   row("back end: window + Ceres", r.window_ms);
+  row("  of which Ceres Solve() (own timer)", r.ceres_ms);
   row("back end: process() total", r.odometry_ms);
   row("pipeline: process() total", r.total_ms);
   row("pipeline: thread CPU time", r.cpu_ms);
@@ -192,8 +255,31 @@ void printRun(const Run& r) {
       "circular-tracked median %.0f, RANSAC inliers median %.0f (min %.0f)\n",
       r.tracking, r.recovered, r.lost, percentile(r.features, 0.5), percentile(r.tracked, 0.5),
       percentile(r.inliers, 0.5), percentile(r.inliers, 0.0));
+  std::printf("window landmarks median %.0f (max %.0f), Ceres iterations median %.0f (max %.0f)\n",
+              percentile(r.landmarks, 0.5), percentile(r.landmarks, 1.0),
+              percentile(r.iterations, 0.5), percentile(r.iterations, 1.0));
   std::printf("RSS after warm-up %ld kB, at end %ld kB (change %+ld kB)\n", r.rss_warm_kb,
               r.rss_end_kb, r.rss_end_kb - r.rss_warm_kb);
+}
+
+void printTracks(const Run& r) {
+  std::printf("\n[back end only, track mode] %zu frames of %s (frame 0 excluded)\n",
+              r.odometry_ms.size(), g_config.tracks.c_str());
+  std::printf("%-36s %9s %9s %9s %9s %9s\n", "wall time per frame [ms]", "median", "p95", "p99",
+              "max", "mean");
+  row("association + RANSAC", r.ransac_ms);
+  row("window + Ceres", r.window_ms);
+  row("  of which Ceres Solve() (own timer)", r.ceres_ms);
+  row("StereoOdometry::process() total", r.odometry_ms);
+  row("thread CPU time", r.cpu_ms);
+  row("heap allocations per frame", r.alloc_odometry);
+  std::printf(
+      "status: %d tracking, %d recovered, %d lost; RANSAC inliers median %.0f, window "
+      "landmarks median %.0f, Ceres iterations median %.0f\n",
+      r.tracking, r.recovered, r.lost, percentile(r.inliers, 0.5), percentile(r.landmarks, 0.5),
+      percentile(r.iterations, 0.5));
+  std::printf("RSS before %ld kB, after %ld kB (change %+ld kB)\n", r.rss_warm_kb, r.rss_end_kb,
+              r.rss_end_kb - r.rss_warm_kb);
 }
 
 void printSummary() {
@@ -212,6 +298,7 @@ void printSummary() {
     std::printf("  window + Ceres            %10.2f             [full - ransac_only]\n",
                 backend - ransac);
   }
+  if (g_tracks.ok) printTracks(g_tracks);
   const double p50 = percentile(g_full.total_ms, 0.5);
   const double p99 = percentile(g_full.total_ms, 0.99);
   std::printf(
@@ -235,6 +322,8 @@ int main(int argc, char** argv) {
       g_config.cpu = std::atoi(a.c_str() + 6);
     } else if (a.rfind("--data=", 0) == 0) {
       g_config.data = a.substr(7);
+    } else if (a.rfind("--tracks=", 0) == 0) {
+      g_config.tracks = a.substr(9);
     } else {
       rest.push_back(argv[i]);
     }
@@ -267,6 +356,19 @@ int main(int argc, char** argv) {
       ->Iterations(g_config.frames)
       ->Unit(benchmark::kMillisecond)
       ->UseRealTime();
+  if (!g_config.tracks.empty()) {
+    auto seq = sunvo::files::readTrackFolder(g_config.tracks, sunvo::files::TrackReadOptions{});
+    if (!seq) {
+      std::fprintf(stderr, "%s\n", seq.status().toString().c_str());
+      return 1;
+    }
+    g_track_seq = std::move(*seq);
+    g_tracks.name = "tracks";
+    benchmark::RegisterBenchmark("vo/backend_only/kitti_tracks_0020", benchTracks)
+        ->Iterations(static_cast<benchmark::IterationCount>(g_track_seq.frames.size()))
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
+  }
   int rest_argc = static_cast<int>(rest.size());
   benchmark::Initialize(&rest_argc, rest.data());
   benchmark::RunSpecifiedBenchmarks();
