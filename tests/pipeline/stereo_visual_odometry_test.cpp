@@ -117,6 +117,8 @@ TEST_F(KittiPipeline, RealFramesMatchGroundTruthDirectionAndRotation) {
     EXPECT_LE(f.times.detect_ms + f.times.temporal_ms + f.times.stereo_ms,
               f.times.frontend_ms + 1e-6);
     EXPECT_LE(f.times.frontend_ms + f.times.odometry_ms, f.times.total_ms + 1e-6);
+    EXPECT_GT(f.times.detect_cpu_ms, 0.0);
+    EXPECT_GT(f.times.total_cpu_ms, f.times.frontend_cpu_ms);
   }
   double max_rot = 0.0;
   double max_dir = 0.0;

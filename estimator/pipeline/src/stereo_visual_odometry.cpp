@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <string>
 
 namespace sunvo::pipeline {
@@ -17,6 +18,13 @@ double msBetween(std::chrono::steady_clock::time_point a, std::chrono::steady_cl
 
 double nsToMs(std::int64_t ns) {
   return static_cast<double>(ns) * 1e-6;
+}
+
+// CPU time of the calling thread, ms; 0 if the clock is unavailable.
+double threadCpuMs() {
+  timespec ts{};
+  if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) != 0) return 0.0;
+  return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
 }
 
 }  // namespace
@@ -75,6 +83,7 @@ Expected<FrameResult> StereoVisualOdometry::process(const StereoFrame& frame) {
   if (!initialized_) return failedPrecondition("StereoVisualOdometry::process before init");
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
+  const double cpu0 = threadCpuMs();
   FrameResult r;
   if (options_.rotation_hint && have_motion_) {
     float du = 0.0F;
@@ -91,9 +100,11 @@ Expected<FrameResult> StereoVisualOdometry::process(const StereoFrame& frame) {
       frontend_.process(frame.left, frame.right, frame.trigger_time_ns, frame.sequence, features_));
   const std::uint64_t c1 = counter_ != nullptr ? counter_() : 0;
   const auto t1 = Clock::now();
+  const double cpu1 = threadCpuMs();
   Expected<vo::VoResult> vr = odometry_.process(features_);
   const std::uint64_t c2 = counter_ != nullptr ? counter_() : 0;
   const auto t2 = Clock::now();
+  const double cpu2 = threadCpuMs();
   if (!vr) return vr.status();
 
   r.vo = *vr;
@@ -116,6 +127,11 @@ Expected<FrameResult> StereoVisualOdometry::process(const StereoFrame& frame) {
   r.times.ransac_ms = r.vo.ransac_ms;
   r.times.window_ms = r.vo.window_ms;
   r.times.odometry_ms = msBetween(t1, t2);
+  r.times.detect_cpu_ms = nsToMs(r.frontend.detect_cpu_ns);
+  r.times.match_cpu_ms = nsToMs(r.frontend.temporal_cpu_ns + r.frontend.stereo_cpu_ns);
+  r.times.frontend_cpu_ms = cpu1 - cpu0;
+  r.times.odometry_cpu_ms = cpu2 - cpu1;
+  r.times.total_cpu_ms = threadCpuMs() - cpu0;
   r.times.total_ms = msBetween(t0, Clock::now());
   return r;
 }

@@ -55,16 +55,22 @@ struct PipelineOptions {
   Status validate() const;
 };
 
-// Wall times of one process() call, ms (monotonic clock).
+// Times of one process() call, ms: wall time (monotonic clock) and CPU time of the calling thread
+// (*_cpu_ms; lower than the wall time when the core is shared with other work).
 struct StageTimes {
-  double detect_ms = 0.0;    // front end: smoothing, gradients, responses, NMS, descriptors
-  double temporal_ms = 0.0;  // front end: tracks around the circle (previous <-> current)
-  double stereo_ms = 0.0;    // front end: new features, left <-> right matching, subpixel
-  double frontend_ms = 0.0;  // the whole front end call (>= detect + temporal + stereo)
-  double ransac_ms = 0.0;    // back end: association by id + 3-point RANSAC
-  double window_ms = 0.0;    // back end: window update + Ceres solve
-  double odometry_ms = 0.0;  // the whole back end call (>= ransac + window)
-  double total_ms = 0.0;     // process() from entry to return
+  double detect_ms = 0.0;        // front end: smoothing, gradients, responses, NMS, descriptors
+  double temporal_ms = 0.0;      // front end: tracks around the circle (previous <-> current)
+  double stereo_ms = 0.0;        // front end: new features, left <-> right matching, subpixel
+  double frontend_ms = 0.0;      // the whole front end call (>= detect + temporal + stereo)
+  double ransac_ms = 0.0;        // back end: association by id + 3-point RANSAC
+  double window_ms = 0.0;        // back end: window update + Ceres solve
+  double odometry_ms = 0.0;      // the whole back end call (>= ransac + window)
+  double total_ms = 0.0;         // process() from entry to return
+  double detect_cpu_ms = 0.0;    // CPU time of detect
+  double match_cpu_ms = 0.0;     // CPU time of temporal + stereo matching
+  double frontend_cpu_ms = 0.0;  // CPU time of the whole front end call
+  double odometry_cpu_ms = 0.0;  // CPU time of the whole back end call
+  double total_cpu_ms = 0.0;     // CPU time of process()
 
   double matchMs() const { return temporal_ms + stereo_ms; }
 };
