@@ -1,5 +1,6 @@
 #include "sunvo/bench/bench_support.hpp"
 
+#include <malloc.h>
 #include <sched.h>
 
 #include <algorithm>
@@ -57,6 +58,11 @@ long procStatusKb(const char* key) {
     if (line.compare(0, n, key) == 0) return std::strtol(line.c_str() + n, nullptr, 10);
   }
   return -1;
+}
+
+long heapInUseKb() {
+  const struct mallinfo2 mi = mallinfo2();
+  return static_cast<long>((mi.uordblks + mi.hblkhd) / 1024);
 }
 
 double threadCpuMs() {

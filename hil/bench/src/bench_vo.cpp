@@ -62,6 +62,9 @@ struct Run {
   int recovered = 0;
   long rss_warm_kb = 0;
   long rss_end_kb = 0;
+  long heap_warm_kb = 0;  // heap in use (mallinfo2)
+  long heap_end_kb = 0;
+  std::vector<long> heap_trace_kb;  // heap in use every 100 frames (track mode)
   bool ok = false;
 };
 
@@ -112,6 +115,7 @@ void runPipeline(benchmark::State& state, bool use_window, Run& r) {
     v->reserve(frames);
   }
   r.rss_warm_kb = sunvo::bench::procStatusKb("VmRSS:");
+  r.heap_warm_kb = sunvo::bench::heapInUseKb();
   bool failed = false;
   for (auto _ : state) {
     const double cpu0 = sunvo::bench::threadCpuMs();
@@ -161,6 +165,7 @@ void runPipeline(benchmark::State& state, bool use_window, Run& r) {
     }
   }
   r.rss_end_kb = sunvo::bench::procStatusKb("VmRSS:");
+  r.heap_end_kb = sunvo::bench::heapInUseKb();
   if (failed) {
     state.SkipWithError("process failed");
     return;
@@ -181,7 +186,14 @@ void benchTracks(benchmark::State& state) {
     state.SkipWithError(st.toString().c_str());
     return;
   }
+  for (auto* v : {&r.ransac_ms, &r.window_ms, &r.ceres_ms, &r.odometry_ms, &r.cpu_ms,
+                  &r.alloc_odometry, &r.inliers, &r.landmarks, &r.iterations}) {
+    v->clear();
+    v->reserve(g_track_seq.frames.size());
+  }
+  r.heap_trace_kb.reserve(g_track_seq.frames.size() / 100 + 1);
   r.rss_warm_kb = sunvo::bench::procStatusKb("VmRSS:");
+  r.heap_warm_kb = sunvo::bench::heapInUseKb();
   std::size_t k = 0;
   bool failed = false;
   for (auto _ : state) {
@@ -197,6 +209,7 @@ void benchTracks(benchmark::State& state) {
       failed = true;
       continue;
     }
+    if (k % 100 == 0) r.heap_trace_kb.push_back(sunvo::bench::heapInUseKb());
     if (k == 1) continue;  // frame 0 only initialises
     r.ransac_ms.push_back(res->ransac_ms);
     r.window_ms.push_back(res->window_ms);
@@ -212,6 +225,7 @@ void benchTracks(benchmark::State& state) {
     if (res->status == sunvo::vo::TrackingStatus::kTracking) ++r.tracking;
   }
   r.rss_end_kb = sunvo::bench::procStatusKb("VmRSS:");
+  r.heap_end_kb = sunvo::bench::heapInUseKb();
   if (failed) {
     state.SkipWithError("process failed");
     return;
@@ -272,8 +286,11 @@ void printRun(const Run& r) {
   std::printf("window landmarks median %.0f (max %.0f), Ceres iterations median %.0f (max %.0f)\n",
               percentile(r.landmarks, 0.5), percentile(r.landmarks, 1.0),
               percentile(r.iterations, 0.5), percentile(r.iterations, 1.0));
-  std::printf("RSS after warm-up %ld kB, at end %ld kB (change %+ld kB)\n", r.rss_warm_kb,
-              r.rss_end_kb, r.rss_end_kb - r.rss_warm_kb);
+  std::printf(
+      "RSS after warm-up %ld kB, at end %ld kB (change %+ld kB); heap in use %ld kB, "
+      "%ld kB (change %+ld kB)\n",
+      r.rss_warm_kb, r.rss_end_kb, r.rss_end_kb - r.rss_warm_kb, r.heap_warm_kb, r.heap_end_kb,
+      r.heap_end_kb - r.heap_warm_kb);
 }
 
 void printTracks(const Run& r) {
@@ -292,8 +309,14 @@ void printTracks(const Run& r) {
       "landmarks median %.0f, Ceres iterations median %.0f\n",
       r.tracking, r.recovered, r.lost, percentile(r.inliers, 0.5), percentile(r.landmarks, 0.5),
       percentile(r.iterations, 0.5));
-  std::printf("RSS before %ld kB, after %ld kB (change %+ld kB)\n", r.rss_warm_kb, r.rss_end_kb,
-              r.rss_end_kb - r.rss_warm_kb);
+  std::printf(
+      "RSS before %ld kB, after %ld kB (change %+ld kB); heap in use %ld kB, %ld kB "
+      "(change %+ld kB)\n",
+      r.rss_warm_kb, r.rss_end_kb, r.rss_end_kb - r.rss_warm_kb, r.heap_warm_kb, r.heap_end_kb,
+      r.heap_end_kb - r.heap_warm_kb);
+  std::printf("heap in use every 100 frames [kB]:");
+  for (long h : r.heap_trace_kb) std::printf(" %ld", h);
+  std::printf("\n");
 }
 
 void printSummary() {

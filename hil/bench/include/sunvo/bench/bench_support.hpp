@@ -34,6 +34,10 @@ double percentile(std::vector<double> v, double q);
 // A "Key:" line of /proc/self/status ("VmRSS:", "VmHWM:") in kB; -1 if unreadable.
 long procStatusKb(const char* key);
 
+// Bytes of heap memory in use (glibc mallinfo2: arena uordblks + mmapped hblkhd), kB. Unlike the
+// RSS it does not count freed memory that the allocator keeps, so its growth means live objects.
+long heapInUseKb();
+
 // CPU time of the calling thread, ms.
 double threadCpuMs();
 
