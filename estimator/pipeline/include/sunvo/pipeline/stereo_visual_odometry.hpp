@@ -43,10 +43,9 @@ inline FrontendOptions defaultPipelineFrontendOptions() {
 }
 
 struct PipelineOptions {
-  FrontendOptions frontend =
-      defaultPipelineFrontendOptions();  // see stereo_frontend.hpp;
-                                         //   frontend.max_features <= vo.max_observations
-  vo::VoOptions vo;                      // see stereo_odometry.hpp
+  // See stereo_frontend.hpp; frontend.max_features must be <= vo.max_observations.
+  FrontendOptions frontend = defaultPipelineFrontendOptions();
+  vo::VoOptions vo;            // see stereo_odometry.hpp
   bool rotation_hint = true;   // centre the front end's un-predicted temporal search on the image
                                //   shift of the last measured rotation (see the header comment)
   double max_hint_px = 100.0;  // px, [0, 1000]: a larger predicted shift is not used as a hint
