@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "sunvo/bench/kitti_sample.hpp"
+#include "../support/kitti_first_frames.hpp"
 #include "sunvo/frontend/stereo_frontend.hpp"
 
 #if defined(SUNVO_HAVE_ALLOC_COUNTER)
@@ -304,10 +304,9 @@ TEST(StereoFrontend, IdsPersistOverSeveralFramesAndResetStartsFresh) {
 class KittiFrontend : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    auto s = bench::loadKittiOdometrySample(std::string(SUNVO_DATA_DIR) +
-                                            "/kitti_odometry/00_first_frames");
+    auto s = testing::loadKittiFirstFrames();
     ASSERT_TRUE(s.hasValue()) << s.status().toString();
-    sample_ = new bench::KittiOdometrySample(std::move(*s));
+    sample_ = new testing::KittiFrames(std::move(*s));
   }
   static void TearDownTestSuite() {
     delete sample_;
@@ -317,18 +316,17 @@ class KittiFrontend : public ::testing::Test {
   static void runAll(std::vector<FrameFeatures>* frames, std::vector<FrontendStats>* stats) {
     StereoFrontend fe;
     ASSERT_TRUE(fe.init(FrontendOptions{}, sample_->camera).isOk());
-    for (std::size_t k = 0; k < sample_->left.size(); ++k) {
+    for (std::size_t k = 0; k < sample_->frames.size(); ++k) {
       FrameFeatures f;
-      ASSERT_TRUE(fe.process(sample_->left[k], sample_->right[k],
-                             static_cast<TimeNs>(sample_->times_s[k] * 1e9), k, f)
-                      .isOk());
+      const StereoFrame& sf = sample_->frames[k];
+      ASSERT_TRUE(fe.process(sf.left, sf.right, sf.trigger_time_ns, k, f).isOk());
       frames->push_back(f);
       stats->push_back(fe.lastStats());
     }
   }
-  static bench::KittiOdometrySample* sample_;
+  static testing::KittiFrames* sample_;
 };
-bench::KittiOdometrySample* KittiFrontend::sample_ = nullptr;
+testing::KittiFrames* KittiFrontend::sample_ = nullptr;
 
 // Bounds are the values measured on these frames (see the printed summary) with a margin of
 // about 20 %: measured min 597 stereo matches, min 342 circular matches, min share 0.55 of the
@@ -431,8 +429,10 @@ TEST_F(KittiFrontend, AcceptsTheOtherKittiImageSize) {
   FrameFeatures out;
   for (std::size_t k = 0; k < 3; ++k) {
     cv::Mat l, r;
-    cv::copyMakeBorder(sample_->left[k].rowRange(0, 375), l, 0, 0, 0, 1, cv::BORDER_REPLICATE);
-    cv::copyMakeBorder(sample_->right[k].rowRange(0, 375), r, 0, 0, 0, 1, cv::BORDER_REPLICATE);
+    cv::copyMakeBorder(sample_->frames[k].left.rowRange(0, 375), l, 0, 0, 0, 1,
+                       cv::BORDER_REPLICATE);
+    cv::copyMakeBorder(sample_->frames[k].right.rowRange(0, 375), r, 0, 0, 0, 1,
+                       cv::BORDER_REPLICATE);
     ASSERT_EQ(l.cols, 1242);
     ASSERT_TRUE(fe.process(l, r, 0, k, out).isOk());
     EXPECT_GE(out.observations.size(), 500u);
@@ -467,12 +467,12 @@ TEST_F(KittiFrontend, NoHeapAllocationAfterTheFirstFrame) {
   StereoFrontend fe;
   ASSERT_TRUE(fe.init(FrontendOptions{}, sample_->camera).isOk());
   FrameFeatures out;  // capacity not reserved: the first process() may allocate it
-  ASSERT_TRUE(fe.process(sample_->left[0], sample_->right[0], 0, 0, out).isOk());
+  ASSERT_TRUE(fe.process(sample_->frames[0].left, sample_->frames[0].right, 0, 0, out).isOk());
   std::uint64_t total = 0;
   for (std::size_t i = 1; i < 30; ++i) {
     const std::size_t k = (i % 20) <= 10 ? i % 20 : 20 - i % 20;  // 1..10..0..9
     bench::AllocationScope scope;
-    const Status s = fe.process(sample_->left[k], sample_->right[k], 0, i, out);
+    const Status s = fe.process(sample_->frames[k].left, sample_->frames[k].right, 0, i, out);
     total += scope.count();
     ASSERT_TRUE(s.isOk());
   }

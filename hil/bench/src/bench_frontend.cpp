@@ -7,25 +7,26 @@
 //   --cpu=K pins the process to CPU K (sched_setaffinity) before anything runs.
 
 #include <benchmark/benchmark.h>
-#include <sched.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
-#include <ctime>
-#include <fstream>
 #include <opencv2/core/utility.hpp>
 #include <string>
 #include <vector>
 
 #include "sunvo/bench/alloc_counter.hpp"
-#include "sunvo/bench/kitti_sample.hpp"
+#include "sunvo/bench/bench_support.hpp"
 #include "sunvo/frontend/stereo_frontend.hpp"
 
 namespace {
+
+using sunvo::bench::percentile;
+using sunvo::bench::pingPong;
+using sunvo::bench::procStatusKb;
+using sunvo::bench::threadCpuMs;
 
 struct Config {
   int frames = 500;
@@ -48,39 +49,7 @@ struct Results {
 
 Config g_config;
 Results g_results;
-sunvo::bench::KittiOdometrySample g_sample;
-
-// "VmRSS:" or "VmHWM:" of /proc/self/status in kB; -1 if unreadable.
-long procStatusKb(const char* key) {
-  std::ifstream f("/proc/self/status");
-  std::string line;
-  const std::size_t n = std::strlen(key);
-  while (std::getline(f, line)) {
-    if (line.compare(0, n, key) == 0) return std::strtol(line.c_str() + n, nullptr, 10);
-  }
-  return -1;
-}
-
-// CPU time of this thread, ms.
-double threadCpuMs() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
-}
-
-// 0,1,..,10,9,..,1,0,1,.. for 11 frames.
-std::size_t pingPong(std::size_t i, std::size_t n) {
-  const std::size_t period = 2 * (n - 1);
-  const std::size_t k = i % period;
-  return k < n ? k : period - k;
-}
-
-double percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const auto rank = static_cast<std::size_t>(std::ceil(q * static_cast<double>(v.size())));
-  return v[std::min(v.size() - 1, rank == 0 ? 0 : rank - 1)];
-}
+sunvo::bench::KittiFrames g_sample;
 
 void benchFrontend(benchmark::State& state) {
   sunvo::StereoFrontend fe;
@@ -94,11 +63,11 @@ void benchFrontend(benchmark::State& state) {
   }
   sunvo::FrameFeatures out;
   fe.reserveOutput(out);
-  const std::size_t n = g_sample.left.size();
+  const std::size_t n = g_sample.frames.size();
   std::size_t frame = 0;
   for (int i = 0; i < g_config.warmup; ++i, ++frame) {
     const std::size_t k = pingPong(frame, n);
-    if (!fe.process(g_sample.left[k], g_sample.right[k], 0, frame, out).isOk()) {
+    if (!fe.process(g_sample.frames[k].left, g_sample.frames[k].right, 0, frame, out).isOk()) {
       state.SkipWithError("process failed in warm-up");
       return;
     }
@@ -120,7 +89,8 @@ void benchFrontend(benchmark::State& state) {
     const auto t0 = std::chrono::steady_clock::now();
     const double cpu0 = threadCpuMs();
     const std::uint64_t a0 = sunvo::bench::allocationCount();
-    const sunvo::Status s = fe.process(g_sample.left[k], g_sample.right[k], 0, frame, out);
+    const sunvo::Status s =
+        fe.process(g_sample.frames[k].left, g_sample.frames[k].right, 0, frame, out);
     const std::uint64_t a1 = sunvo::bench::allocationCount();
     const double cpu1 = threadCpuMs();
     const auto t1 = std::chrono::steady_clock::now();
@@ -222,11 +192,9 @@ int main(int argc, char** argv) {
     }
   }
   if (g_config.cpu >= 0) {
-    cpu_set_t set;
-    CPU_ZERO(&set);
-    CPU_SET(g_config.cpu, &set);
-    if (sched_setaffinity(0, sizeof(set), &set) != 0) {
-      std::fprintf(stderr, "cannot pin to CPU %d\n", g_config.cpu);
+    const sunvo::Status s = sunvo::bench::pinToCpu(g_config.cpu);
+    if (!s.isOk()) {
+      std::fprintf(stderr, "%s\n", s.toString().c_str());
       return 1;
     }
     std::printf("pinned to CPU %d\n", g_config.cpu);
@@ -235,7 +203,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "allocation counter is not active in this binary\n");
     return 1;
   }
-  auto sample = sunvo::bench::loadKittiOdometrySample(g_config.data);
+  auto sample = sunvo::bench::loadKittiOdometryFrames(g_config.data);
   if (!sample) {
     std::fprintf(stderr, "%s\n", sample.status().toString().c_str());
     return 1;

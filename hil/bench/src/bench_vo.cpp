@@ -1,0 +1,421 @@
+// Full image VO benchmark on real KITTI images: StereoVisualOdometry (front end + 3-point RANSAC +
+// Ceres window) on the 11 frames of 00_first_frames played forward and backward (0..10..0..),
+// single-threaded (cv::setNumThreads(0); the pipeline starts no threads). Prints per-stage wall
+// time median/p95/p99/max, heap allocations per frame per stage in steady state, the resident set
+// size after warm-up and at the end, and measured/target ratios (targets: 20 ms median, 35 ms p99
+// per frame).
+//
+// Two runs over the same frames: "full" (the default pipeline) and "ransac_only"
+// (vo.use_window = false). The front end is deterministic and RANSAC is seeded per frame, so the
+// back end of the second run makes the same association + RANSAC calls: its allocations are
+// RANSAC's, and the window's are the full run's back-end allocations minus those.
+//
+// A third run times the back end alone (vo::StereoOdometry, track mode) on the real feature tracks
+// of KITTI 2011_09_30_drive_0020 (1000 frames, SURF+KLT tracks, ~65 observations per frame).
+//
+// Usage: sunvo_bench_vo [--frames=N] [--warmup=N] [--data=DIR] [--tracks=DIR|--tracks=]
+//                       [--cpu=K] [benchmark flags]
+//   --cpu=K pins the process to CPU K (sched_setaffinity) before anything runs;
+//   --tracks= (empty) skips the track-mode run.
+
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <opencv2/core/utility.hpp>
+#include <string>
+#include <vector>
+
+#include "sunvo/bench/alloc_counter.hpp"
+#include "sunvo/bench/bench_support.hpp"
+#include "sunvo/files/tracks_io.hpp"
+#include "sunvo/pipeline/stereo_visual_odometry.hpp"
+
+namespace {
+
+using sunvo::bench::percentile;
+
+constexpr double kTargetMedianMs = 20.0;
+constexpr double kTargetP99Ms = 35.0;
+
+struct Config {
+  int frames = 500;
+  int warmup = 20;
+  std::string data = std::string(SUNVO_DATA_DIR) + "/kitti_odometry/00_first_frames";
+  std::string tracks = std::string(SUNVO_DATA_DIR) + "/kitti_tracks/2011_09_30_drive_0020";
+  int cpu = -1;  // pin to this CPU when >= 0
+};
+
+struct Run {
+  const char* name = "";
+  std::vector<double> detect_ms, match_ms, frontend_ms, ransac_ms, window_ms, odometry_ms, total_ms,
+      outer_ms, cpu_ms;
+  std::vector<double> detect_cpu_ms, match_cpu_ms, frontend_cpu_ms, odometry_cpu_ms;
+  std::vector<double> ceres_ms;  // Ceres' own total_time of the window solve
+  std::vector<double> alloc_frontend, alloc_odometry;
+  std::vector<double> features, tracked, inliers, landmarks, iterations;
+  int lost = 0;
+  int tracking = 0;
+  int recovered = 0;
+  long rss_warm_kb = 0;
+  long rss_end_kb = 0;
+  long heap_warm_kb = 0;  // heap in use (mallinfo2)
+  long heap_end_kb = 0;
+  std::vector<long> heap_trace_kb;  // heap in use every 100 frames (track mode)
+  bool ok = false;
+};
+
+Config g_config;
+sunvo::bench::KittiFrames g_data;
+Run g_full;
+Run g_ransac_only;
+Run g_tracks;
+sunvo::files::TrackSequence g_track_seq;
+
+void runPipeline(benchmark::State& state, bool use_window, Run& r) {
+  sunvo::pipeline::PipelineOptions opt;
+  opt.vo.use_window = use_window;
+  sunvo::pipeline::StereoVisualOdometry vo;
+  const sunvo::Status st = vo.init(opt, g_data.camera);
+  if (!st.isOk()) {
+    state.SkipWithError(st.toString().c_str());
+    return;
+  }
+  vo.setStageCounter(&sunvo::bench::allocationCount);
+  const std::size_t n = g_data.frames.size();
+  // Playback copies share the image buffers (cv::Mat headers); only sequence and time change so
+  // that the back end sees a monotonic 10 Hz stream.
+  sunvo::StereoFrame frame;
+  std::size_t i = 0;
+  auto feed = [&](std::size_t index) -> sunvo::Expected<sunvo::pipeline::FrameResult> {
+    const sunvo::StereoFrame& src = g_data.frames[sunvo::bench::pingPong(index, n)];
+    frame.left = src.left;
+    frame.right = src.right;
+    frame.sequence = index;
+    frame.trigger_time_ns = 1'000'000'000 + static_cast<sunvo::TimeNs>(index) * 100'000'000;
+    return vo.process(frame);
+  };
+  for (int w = 0; w < g_config.warmup; ++w, ++i) {
+    if (!feed(i).hasValue()) {
+      state.SkipWithError("process failed in warm-up");
+      return;
+    }
+  }
+  const auto frames = static_cast<std::size_t>(g_config.frames);
+  for (auto* v : {&r.detect_ms,       &r.match_ms,        &r.frontend_ms,    &r.ransac_ms,
+                  &r.window_ms,       &r.odometry_ms,     &r.total_ms,       &r.outer_ms,
+                  &r.cpu_ms,          &r.ceres_ms,        &r.detect_cpu_ms,  &r.match_cpu_ms,
+                  &r.frontend_cpu_ms, &r.odometry_cpu_ms, &r.alloc_frontend, &r.alloc_odometry,
+                  &r.features,        &r.tracked,         &r.inliers,        &r.landmarks,
+                  &r.iterations}) {
+    v->clear();
+    v->reserve(frames);
+  }
+  r.rss_warm_kb = sunvo::bench::procStatusKb("VmRSS:");
+  r.heap_warm_kb = sunvo::bench::heapInUseKb();
+  bool failed = false;
+  for (auto _ : state) {
+    const double cpu0 = sunvo::bench::threadCpuMs();
+    const auto t0 = std::chrono::steady_clock::now();
+    auto res = feed(i);
+    const auto t1 = std::chrono::steady_clock::now();
+    const double cpu1 = sunvo::bench::threadCpuMs();
+    ++i;
+    if (!res.hasValue()) {
+      failed = true;
+      continue;
+    }
+    const sunvo::pipeline::FrameResult& f = *res;
+    r.detect_ms.push_back(f.times.detect_ms);
+    r.match_ms.push_back(f.times.matchMs());
+    r.frontend_ms.push_back(f.times.frontend_ms);
+    r.ransac_ms.push_back(f.times.ransac_ms);
+    r.window_ms.push_back(f.times.window_ms);
+    r.odometry_ms.push_back(f.times.odometry_ms);
+    r.total_ms.push_back(f.times.total_ms);
+    r.outer_ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+    r.cpu_ms.push_back(cpu1 - cpu0);
+    r.alloc_frontend.push_back(static_cast<double>(f.frontend_counter_delta));
+    r.alloc_odometry.push_back(static_cast<double>(f.odometry_counter_delta));
+    r.features.push_back(f.num_features);
+    r.tracked.push_back(f.frontend.tracks_kept);
+    r.inliers.push_back(f.vo.ransac_inliers);
+    r.ceres_ms.push_back(f.vo.solver_time_s * 1e3);
+    r.detect_cpu_ms.push_back(f.times.detect_cpu_ms);
+    r.match_cpu_ms.push_back(f.times.match_cpu_ms);
+    r.frontend_cpu_ms.push_back(f.times.frontend_cpu_ms);
+    r.odometry_cpu_ms.push_back(f.times.odometry_cpu_ms);
+    r.landmarks.push_back(f.vo.window_landmarks);
+    r.iterations.push_back(f.vo.solver_iterations);
+    switch (f.vo.status) {
+      case sunvo::vo::TrackingStatus::kLost:
+        ++r.lost;
+        break;
+      case sunvo::vo::TrackingStatus::kRecovered:
+        ++r.recovered;
+        break;
+      case sunvo::vo::TrackingStatus::kTracking:
+        ++r.tracking;
+        break;
+      case sunvo::vo::TrackingStatus::kInitializing:
+        break;
+    }
+  }
+  r.rss_end_kb = sunvo::bench::procStatusKb("VmRSS:");
+  r.heap_end_kb = sunvo::bench::heapInUseKb();
+  if (failed) {
+    state.SkipWithError("process failed");
+    return;
+  }
+  state.counters["total_ms_p50"] = percentile(r.total_ms, 0.5);
+  state.counters["total_ms_p99"] = percentile(r.total_ms, 0.99);
+  state.counters["lost"] = r.lost;
+  r.ok = true;
+}
+
+// The back end alone on recorded real tracks: every frame of the sequence once, in order.
+void benchTracks(benchmark::State& state) {
+  Run& r = g_tracks;
+  sunvo::vo::StereoOdometry vo;
+  const sunvo::Status st =
+      vo.init(sunvo::vo::VoOptions{}, g_track_seq.camera, sunvo::Isometry3::Identity());
+  if (!st.isOk()) {
+    state.SkipWithError(st.toString().c_str());
+    return;
+  }
+  for (auto* v : {&r.ransac_ms, &r.window_ms, &r.ceres_ms, &r.odometry_ms, &r.cpu_ms,
+                  &r.alloc_odometry, &r.inliers, &r.landmarks, &r.iterations}) {
+    v->clear();
+    v->reserve(g_track_seq.frames.size());
+  }
+  r.heap_trace_kb.reserve(g_track_seq.frames.size() / 100 + 1);
+  r.rss_warm_kb = sunvo::bench::procStatusKb("VmRSS:");
+  r.heap_warm_kb = sunvo::bench::heapInUseKb();
+  std::size_t k = 0;
+  bool failed = false;
+  for (auto _ : state) {
+    const std::uint64_t a0 = sunvo::bench::allocationCount();
+    const double cpu0 = sunvo::bench::threadCpuMs();
+    const auto t0 = std::chrono::steady_clock::now();
+    auto res = vo.process(g_track_seq.frames[k]);
+    const auto t1 = std::chrono::steady_clock::now();
+    const double cpu1 = sunvo::bench::threadCpuMs();
+    const std::uint64_t a1 = sunvo::bench::allocationCount();
+    ++k;
+    if (!res.hasValue()) {
+      failed = true;
+      continue;
+    }
+    if (k % 100 == 0) r.heap_trace_kb.push_back(sunvo::bench::heapInUseKb());
+    if (k == 1) continue;  // frame 0 only initialises
+    r.ransac_ms.push_back(res->ransac_ms);
+    r.window_ms.push_back(res->window_ms);
+    r.ceres_ms.push_back(res->solver_time_s * 1e3);
+    r.odometry_ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+    r.cpu_ms.push_back(cpu1 - cpu0);
+    r.alloc_odometry.push_back(static_cast<double>(a1 - a0));
+    r.inliers.push_back(res->ransac_inliers);
+    r.landmarks.push_back(res->window_landmarks);
+    r.iterations.push_back(res->solver_iterations);
+    if (res->status == sunvo::vo::TrackingStatus::kLost) ++r.lost;
+    if (res->status == sunvo::vo::TrackingStatus::kRecovered) ++r.recovered;
+    if (res->status == sunvo::vo::TrackingStatus::kTracking) ++r.tracking;
+  }
+  r.rss_end_kb = sunvo::bench::procStatusKb("VmRSS:");
+  r.heap_end_kb = sunvo::bench::heapInUseKb();
+  if (failed) {
+    state.SkipWithError("process failed");
+    return;
+  }
+  r.ok = true;
+}
+
+void benchFull(benchmark::State& state) {
+  runPipeline(state, true, g_full);
+}
+void benchRansacOnly(benchmark::State& state) {
+  runPipeline(state, false, g_ransac_only);
+}
+
+double mean(const std::vector<double>& v) {
+  double s = 0.0;
+  for (double x : v) s += x;
+  return v.empty() ? 0.0 : s / static_cast<double>(v.size());
+}
+
+void row(const char* name, const std::vector<double>& v) {
+  std::printf("%-36s %9.3f %9.3f %9.3f %9.3f %9.3f\n", name, percentile(v, 0.5),
+              percentile(v, 0.95), percentile(v, 0.99), percentile(v, 1.0), mean(v));
+}
+
+void printRun(const Run& r) {
+  std::printf(
+      "\n[%s] %zu frames of %dx%d (00_first_frames ping-pong) after %d warm-up frames, "
+      "one thread\n",
+      r.name, r.total_ms.size(), g_data.camera.width, g_data.camera.height, g_config.warmup);
+  std::printf("%-36s %9s %9s %9s %9s %9s\n", "wall time per frame [ms]", "median", "p95", "p99",
+              "max", "mean");
+  row("front end: detect (both images)", r.detect_ms);
+  row("front end: match (temporal+stereo)", r.match_ms);
+  row("front end: process() total", r.frontend_ms);
+  row("back end: association + RANSAC", r.ransac_ms);
+  row("back end: window + Ceres", r.window_ms);
+  row("  of which Ceres Solve() (own timer)", r.ceres_ms);
+  row("back end: process() total", r.odometry_ms);
+  row("pipeline: process() total", r.total_ms);
+  row("pipeline: outer wall (incl. call)", r.outer_ms);
+  std::printf("%-36s %9s %9s %9s %9s %9s\n", "thread CPU time per frame [ms]", "median", "p95",
+              "p99", "max", "mean");
+  row("front end: detect (both images)", r.detect_cpu_ms);
+  row("front end: match (temporal+stereo)", r.match_cpu_ms);
+  row("front end: process() total", r.frontend_cpu_ms);
+  row("back end: process() total", r.odometry_cpu_ms);
+  row("pipeline: process() total", r.cpu_ms);
+  std::printf("%-36s %9s %9s %9s %9s %9s\n", "heap allocations per frame", "median", "p95", "p99",
+              "max", "mean");
+  row("front end", r.alloc_frontend);
+  row("back end (association+RANSAC+window)", r.alloc_odometry);
+  std::printf(
+      "status: %d tracking, %d recovered, %d lost; features/frame median %.0f, "
+      "circular-tracked median %.0f, RANSAC inliers median %.0f (min %.0f)\n",
+      r.tracking, r.recovered, r.lost, percentile(r.features, 0.5), percentile(r.tracked, 0.5),
+      percentile(r.inliers, 0.5), percentile(r.inliers, 0.0));
+  std::printf("window landmarks median %.0f (max %.0f), Ceres iterations median %.0f (max %.0f)\n",
+              percentile(r.landmarks, 0.5), percentile(r.landmarks, 1.0),
+              percentile(r.iterations, 0.5), percentile(r.iterations, 1.0));
+  std::printf(
+      "RSS after warm-up %ld kB, at end %ld kB (change %+ld kB); heap in use %ld kB, "
+      "%ld kB (change %+ld kB)\n",
+      r.rss_warm_kb, r.rss_end_kb, r.rss_end_kb - r.rss_warm_kb, r.heap_warm_kb, r.heap_end_kb,
+      r.heap_end_kb - r.heap_warm_kb);
+}
+
+void printTracks(const Run& r) {
+  std::printf("\n[back end only, track mode] %zu frames of %s (frame 0 excluded)\n",
+              r.odometry_ms.size(), g_config.tracks.c_str());
+  std::printf("%-36s %9s %9s %9s %9s %9s\n", "wall time per frame [ms]", "median", "p95", "p99",
+              "max", "mean");
+  row("association + RANSAC", r.ransac_ms);
+  row("window + Ceres", r.window_ms);
+  row("  of which Ceres Solve() (own timer)", r.ceres_ms);
+  row("StereoOdometry::process() total", r.odometry_ms);
+  row("thread CPU time", r.cpu_ms);
+  row("heap allocations per frame", r.alloc_odometry);
+  std::printf(
+      "status: %d tracking, %d recovered, %d lost; RANSAC inliers median %.0f, window "
+      "landmarks median %.0f, Ceres iterations median %.0f\n",
+      r.tracking, r.recovered, r.lost, percentile(r.inliers, 0.5), percentile(r.landmarks, 0.5),
+      percentile(r.iterations, 0.5));
+  std::printf(
+      "RSS before %ld kB, after %ld kB (change %+ld kB); heap in use %ld kB, %ld kB "
+      "(change %+ld kB)\n",
+      r.rss_warm_kb, r.rss_end_kb, r.rss_end_kb - r.rss_warm_kb, r.heap_warm_kb, r.heap_end_kb,
+      r.heap_end_kb - r.heap_warm_kb);
+  std::printf("heap in use every 100 frames [kB]:");
+  for (long h : r.heap_trace_kb) std::printf(" %ld", h);
+  std::printf("\n");
+}
+
+void printSummary() {
+  if (!g_full.ok) return;
+  printRun(g_full);
+  if (g_ransac_only.ok) {
+    printRun(g_ransac_only);
+    std::printf("\nper-stage heap allocations per frame (mean over the timed frames)\n");
+    const double fe = mean(g_full.alloc_frontend);
+    const double ransac = mean(g_ransac_only.alloc_odometry);
+    const double backend = mean(g_full.alloc_odometry);
+    std::printf("  front end                 %10.2f (max %.0f)\n", fe,
+                percentile(g_full.alloc_frontend, 1.0));
+    std::printf("  association + RANSAC      %10.2f (max %.0f)   [ransac_only run]\n", ransac,
+                percentile(g_ransac_only.alloc_odometry, 1.0));
+    std::printf("  window + Ceres            %10.2f             [full - ransac_only]\n",
+                backend - ransac);
+  }
+  if (g_tracks.ok) printTracks(g_tracks);
+  const double p50 = percentile(g_full.total_ms, 0.5);
+  const double p99 = percentile(g_full.total_ms, 0.99);
+  std::printf(
+      "\ntargets (full pipeline, wall time per frame): median %.2f ms / %.0f ms = %.2f, "
+      "p99 %.2f ms / %.0f ms = %.2f\n",
+      p50, kTargetMedianMs, p50 / kTargetMedianMs, p99, kTargetP99Ms, p99 / kTargetP99Ms);
+  const double c50 = percentile(g_full.cpu_ms, 0.5);
+  const double c99 = percentile(g_full.cpu_ms, 0.99);
+  std::printf(
+      "same in thread CPU time (what other processes on the core do not inflate): median "
+      "%.2f ms / %.0f ms = %.2f, p99 %.2f ms / %.0f ms = %.2f\n",
+      c50, kTargetMedianMs, c50 / kTargetMedianMs, c99, kTargetP99Ms, c99 / kTargetP99Ms);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  cv::setNumThreads(0);
+  std::vector<char*> rest;
+  for (int i = 0; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a.rfind("--frames=", 0) == 0) {
+      g_config.frames = std::max(1, std::atoi(a.c_str() + 9));
+    } else if (a.rfind("--warmup=", 0) == 0) {
+      g_config.warmup = std::max(0, std::atoi(a.c_str() + 9));
+    } else if (a.rfind("--cpu=", 0) == 0) {
+      g_config.cpu = std::atoi(a.c_str() + 6);
+    } else if (a.rfind("--data=", 0) == 0) {
+      g_config.data = a.substr(7);
+    } else if (a.rfind("--tracks=", 0) == 0) {
+      g_config.tracks = a.substr(9);
+    } else {
+      rest.push_back(argv[i]);
+    }
+  }
+  if (g_config.cpu >= 0) {
+    const sunvo::Status s = sunvo::bench::pinToCpu(g_config.cpu);
+    if (!s.isOk()) {
+      std::fprintf(stderr, "%s\n", s.toString().c_str());
+      return 1;
+    }
+    std::printf("pinned to CPU %d\n", g_config.cpu);
+  }
+  if (!sunvo::bench::allocCounterActive()) {
+    std::fprintf(stderr, "allocation counter is not active in this binary\n");
+    return 1;
+  }
+  auto data = sunvo::bench::loadKittiOdometryFrames(g_config.data);
+  if (!data) {
+    std::fprintf(stderr, "%s\n", data.status().toString().c_str());
+    return 1;
+  }
+  g_data = std::move(*data);
+  g_full.name = "full";
+  g_ransac_only.name = "ransac_only";
+  benchmark::RegisterBenchmark("vo/full/kitti00_first_frames_pingpong", benchFull)
+      ->Iterations(g_config.frames)
+      ->Unit(benchmark::kMillisecond)
+      ->UseRealTime();
+  benchmark::RegisterBenchmark("vo/ransac_only/kitti00_first_frames_pingpong", benchRansacOnly)
+      ->Iterations(g_config.frames)
+      ->Unit(benchmark::kMillisecond)
+      ->UseRealTime();
+  if (!g_config.tracks.empty()) {
+    auto seq = sunvo::files::readTrackFolder(g_config.tracks, sunvo::files::TrackReadOptions{});
+    if (!seq) {
+      std::fprintf(stderr, "%s\n", seq.status().toString().c_str());
+      return 1;
+    }
+    g_track_seq = std::move(*seq);
+    g_tracks.name = "tracks";
+    benchmark::RegisterBenchmark("vo/backend_only/kitti_tracks_0020", benchTracks)
+        ->Iterations(static_cast<benchmark::IterationCount>(g_track_seq.frames.size()))
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
+  }
+  int rest_argc = static_cast<int>(rest.size());
+  benchmark::Initialize(&rest_argc, rest.data());
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  printSummary();
+  return g_full.ok ? 0 : 1;
+}
