@@ -18,8 +18,7 @@
 
 #include "sunvo/experiment/experiment.hpp"
 #include "sunvo/files/trajectory_io.hpp"
-#include "sunvo/report/report.hpp"
-#include "sunvo/report/trajectory_plot.hpp"
+#include "sunvo/report/report_files.hpp"
 
 namespace {
 
@@ -150,26 +149,13 @@ int main(int argc, char** argv) {
       input.estimates.push_back({r.name, "", r.evaluation});
       series.push_back({r.name, r.T_w_c});
     }
-    const std::string table = sunvo::report::table1Markdown(input);
-    std::printf("\n### %s (%zu frames, %.0f m)\n\n%s", route->name.c_str(), input.num_poses,
-                runs.front().evaluation.table1.gt_path_length_m, table.c_str());
-    const std::string stem = out_dir + "/route_" + id;
-    if (auto s = sunvo::files::writeWholeFile(stem + "_table1.md", table); !s.isOk()) {
-      return usage(s.toString());
-    }
-    if (auto s = sunvo::files::writeWholeFile(stem + "_metrics.json",
-                                              sunvo::report::evaluationJson(input));
-        !s.isOk()) {
-      return usage(s.toString());
-    }
     const std::vector<sunvo::Isometry3> gt(
         route->T_w_c_gt.begin(),
         route->T_w_c_gt.begin() + static_cast<std::ptrdiff_t>(input.num_poses));
-    auto plot = sunvo::report::renderTopView(gt, series, input.plane);
-    if (!plot) return usage(plot.status().toString());
-    if (auto s = sunvo::report::writePng(stem + "_topview.png", *plot); !s.isOk()) {
-      return usage(s.toString());
-    }
+    auto table = sunvo::report::writeRouteReport(out_dir + "/route_" + id, input, gt, series);
+    if (!table) return usage(table.status().toString());
+    std::printf("\n### %s (%zu frames, %.0f m)\n\n%s", route->name.c_str(), input.num_poses,
+                runs.front().evaluation.table1.gt_path_length_m, table->c_str());
     const auto& base = runs.front().evaluation.table1;
     for (const RunResult& r : runs) {
       const auto& t = r.evaluation.table1;

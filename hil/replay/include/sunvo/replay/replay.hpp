@@ -1,0 +1,55 @@
+#pragma once
+// Replay of a recorded (or rendered) drive in the KITTI raw layout through the whole estimation
+// chain, as it runs on the rover:
+//   KittiStereoSource (images, UTC timestamps) -> OXTS of the first frame -> local ENU world
+//   (GeographicLib) and the first camera pose through the calibration chain -> per frame:
+//   image pipeline (front end + RANSAC + window) with the sun residual every n-th frame, the sun
+//   in the world from the NREL SPA at the frame's GPS fix and UTC time.
+// Sun measurements come from a sun source: here the drive's ground-truth sun in the camera
+// (gt/sun_cam0.csv, written by the renderer) through an error model, until the image estimators
+// land. Ground truth for the evaluation: gt/poses_cam0_enu.txt (camera 0 in the same ENU frame).
+// Deterministic: the solver is bounded by iterations only.
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "sunvo/experiment/experiment.hpp"
+#include "sunvo/geodesy/local_enu.hpp"
+#include "sunvo/pipeline/stereo_visual_odometry.hpp"
+
+namespace sunvo::replay {
+
+struct ReplayOptions {
+  std::string drive_dir;          // <date>/<date>_drive_NNNN_sync, with oxts/ and gt/
+  std::int64_t utc_offset_s = 0;  // s: offset of the drive's timestamps to UTC (renderer: 0)
+  int every_n_frames = 5;         // a sun measurement every n-th frame, [1, 1000]
+  int max_frames = 0;             // 0 = all
+  pipeline::PipelineOptions pipeline;
+  sunfusion::SunFusionOptions fusion;
+  Status validate() const;
+};
+
+struct ReplayRun {
+  std::string name;
+  std::vector<Isometry3> T_w_c;  // ENU world
+  sunfusion::GateCounters gate;
+  int lost_frames = 0;
+  double median_ms = 0.0;  // pipeline time per frame
+  double p99_ms = 0.0;
+};
+
+struct ReplayData {
+  std::vector<Isometry3> T_w_c_gt;  // ENU
+  std::vector<TimeNs> times_ns;
+  geodesy::GeodeticPoint origin;
+};
+
+// Loads the ground truth of a drive (gt/poses_cam0_enu.txt, image_00/timestamps.txt).
+Expected<ReplayData> loadReplayData(const ReplayOptions& options);
+
+// One run: pure VO (spec == nullopt) or VO + sun from one source.
+Expected<ReplayRun> replayDrive(const ReplayOptions& options,
+                                const std::optional<experiment::SunSourceSpec>& spec);
+
+}  // namespace sunvo::replay

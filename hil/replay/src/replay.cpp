@@ -1,0 +1,145 @@
+#include "sunvo/replay/replay.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "sunvo/files/sun_csv.hpp"
+#include "sunvo/files/trajectory_io.hpp"
+#include "sunvo/geodesy/local_enu.hpp"
+#include "sunvo/kitti/calibration.hpp"
+#include "sunvo/kitti/oxts.hpp"
+#include "sunvo/kitti/stereo_source.hpp"
+#include "sunvo/kitti/timestamps.hpp"
+#include "sunvo/sun/spa.hpp"
+
+namespace sunvo::replay {
+namespace {
+
+double percentile(std::vector<double> v, double p) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  return v[static_cast<std::size_t>(std::lround(p / 100.0 * static_cast<double>(v.size() - 1)))];
+}
+
+std::string parentOf(const std::string& dir) {
+  const std::size_t slash = dir.find_last_of('/', dir.size() > 1 ? dir.size() - 2 : 0);
+  return slash == std::string::npos ? "." : dir.substr(0, slash);
+}
+
+}  // namespace
+
+Status ReplayOptions::validate() const {
+  if (drive_dir.empty()) return invalidArgument("replay.drive_dir is empty");
+  if (every_n_frames < 1 || every_n_frames > 1000) {
+    return invalidArgument("replay.every_n_frames out of range [1, 1000]");
+  }
+  if (max_frames < 0) return invalidArgument("replay.max_frames must be >= 0");
+  SUNVO_RETURN_IF_ERROR(pipeline.validate());
+  return fusion.validate();
+}
+
+Expected<ReplayData> loadReplayData(const ReplayOptions& options) {
+  SUNVO_RETURN_IF_ERROR(options.validate());
+  ReplayData data;
+  auto gt = files::readKittiPoses(options.drive_dir + "/gt/poses_cam0_enu.txt");
+  if (!gt) return gt.status();
+  data.T_w_c_gt = gt->T_w_c;
+  auto times = kitti::readRawTimestamps(options.drive_dir + "/image_00/timestamps.txt",
+                                        options.utc_offset_s);
+  if (!times) return times.status();
+  data.times_ns = *times;
+  auto oxts = kitti::readOxtsRecord(kitti::oxtsRecordPath(options.drive_dir, 0));
+  if (!oxts) return oxts.status();
+  data.origin = {oxts->lat, oxts->lon, oxts->alt};
+  if (data.T_w_c_gt.size() != data.times_ns.size()) {
+    return invalidArgument(options.drive_dir + ": gt/poses_cam0_enu.txt has " +
+                           std::to_string(data.T_w_c_gt.size()) + " poses for " +
+                           std::to_string(data.times_ns.size()) + " frames");
+  }
+  return data;
+}
+
+Expected<ReplayRun> replayDrive(const ReplayOptions& options,
+                                const std::optional<experiment::SunSourceSpec>& spec) {
+  SUNVO_RETURN_IF_ERROR(options.validate());
+  kitti::KittiSourceOptions src_opt;
+  src_opt.root = options.drive_dir;
+  src_opt.layout = kitti::KittiLayout::kRaw;
+  src_opt.utc_offset_s = options.utc_offset_s;
+  if (options.max_frames > 0) src_opt.last_frame = options.max_frames - 1;
+  auto source = kitti::KittiStereoSource::open(src_opt);
+  if (!source) return source.status();
+
+  // The world: local ENU at the first GPS fix. The first camera pose from the first OXTS record
+  // through the drive's calibration chain, as on the rover at start-up.
+  auto oxts = kitti::readOxtsSequence(options.drive_dir, options.utc_offset_s);
+  if (!oxts) return oxts.status();
+  if (oxts->empty()) return notFound(options.drive_dir + "/oxts: no records");
+  const kitti::OxtsRecord& first = oxts->front().record;
+  auto world = geodesy::LocalEnuFrame::create({first.lat, first.lon, first.alt});
+  if (!world) return world.status();
+  auto calib = kitti::readRawCalibration(parentOf(options.drive_dir));
+  if (!calib) return calib.status();
+  const Isometry3 T_c0rect_imu =
+      geodesy::cam0RectFromImu(calib->cam_to_cam.cameras[0].R_rect, calib->velo_to_cam.transform(),
+                               calib->imu_to_velo.transform());
+  auto T_w_imu0 = geodesy::imuPoseInWorld(*world, {first.lat, first.lon, first.alt}, first.roll,
+                                          first.pitch, first.yaw);
+  if (!T_w_imu0) return T_w_imu0.status();
+  const Isometry3 T_w_c0 = geodesy::cam0PoseInWorld(*T_w_imu0, T_c0rect_imu);
+
+  pipeline::PipelineOptions popt = options.pipeline;
+  popt.vo.window.max_solver_time_in_seconds = 60.0;  // replay: bounded by iterations only
+  pipeline::StereoVisualOdometry vo;
+  SUNVO_RETURN_IF_ERROR(vo.init(popt, source->camera(), T_w_c0));
+
+  sunfusion::SunWindowTerm sun_term;
+  std::optional<sunfusion::SimulatedSunSource> sun_source;
+  std::vector<Eigen::Vector3d> sun_c_gt;
+  if (spec) {
+    auto sun_csv = files::readSunCsv(options.drive_dir + "/gt/sun_cam0.csv");
+    if (!sun_csv) return sun_csv.status();
+    sun_c_gt = sun_csv->sun_c;
+    sunfusion::SunFusionOptions fusion = options.fusion;
+    fusion.gate = spec->gate;
+    fusion.world_up = Eigen::Vector3d::UnitZ();  // ENU
+    SUNVO_RETURN_IF_ERROR(sun_term.init(fusion));
+    sun_term.attach(vo.odometry().window());
+    sun_source.emplace(spec->model);
+  }
+
+  ReplayRun run;
+  run.name = spec ? spec->name : "Pure VO";
+  StereoFrame frame;
+  std::vector<double> ms;
+  for (std::size_t k = 0; !source->finished(); ++k) {
+    const Status s = source->next(frame);
+    if (source->finished()) break;
+    SUNVO_RETURN_IF_ERROR(s);
+    if (sun_source && k > 0 && k % static_cast<std::size_t>(options.every_n_frames) == 0 &&
+        k < oxts->size() && k < sun_c_gt.size()) {
+      // The sun in the world from the ephemeris at this frame's GPS fix and UTC time.
+      const kitti::OxtsRecord& fix = (*oxts)[k].record;
+      sun::SpaOptions spa;
+      spa.latitude_deg = fix.lat;
+      spa.longitude_deg = fix.lon;
+      spa.elevation_m = fix.alt;
+      auto sp = sun::computeSolarPosition(frame.trigger_time_ns, spa);
+      if (!sp) return sp.status();
+      auto m = sun_source->measure(frame.sequence, frame.trigger_time_ns, sun_c_gt[k]);
+      if (m) sun_term.addObservation({*m, sp->sun_enu});
+    }
+    auto r = vo.process(frame);
+    if (!r) return r.status();
+    if (r->vo.status == vo::TrackingStatus::kLost) ++run.lost_frames;
+    ms.push_back(r->times.total_ms);
+    run.T_w_c.push_back(r->vo.T_w_c);
+  }
+  run.gate = sun_term.counters();
+  run.median_ms = percentile(ms, 50.0);
+  run.p99_ms = percentile(ms, 99.0);
+  return run;
+}
+
+}  // namespace sunvo::replay
