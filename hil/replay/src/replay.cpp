@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "sunvo/files/sun_csv.hpp"
+#include "sunvo/files/text_file.hpp"
 #include "sunvo/files/trajectory_io.hpp"
 #include "sunvo/geodesy/local_enu.hpp"
 #include "sunvo/kitti/calibration.hpp"
@@ -52,6 +53,35 @@ Expected<ReplayData> loadReplayData(const ReplayOptions& options) {
   auto oxts = kitti::readOxtsRecord(kitti::oxtsRecordPath(options.drive_dir, 0));
   if (!oxts) return oxts.status();
   data.origin = {oxts->lat, oxts->lon, oxts->alt};
+  // The ground truth is in the ENU frame of gt/origin.txt; the replay's world is ENU at the first
+  // GPS fix. Move each pose through WGS84: p_fix = fix(scene^-1(p_scene)), and rotate by the two
+  // frames' local-level rotations at that point, C_fix_scene = C_fix_lev C_scene_lev^T.
+  auto origin_file = files::TextFile::open(options.drive_dir + "/gt/origin.txt");
+  if (!origin_file) return origin_file.status();
+  std::string_view line;
+  if (!origin_file->nextLine(line)) return parseError(origin_file->path() + ": empty");
+  const auto fields = files::splitFields(line);
+  if (fields.size() != 3) return origin_file->lineError("expected 'lat lon alt'");
+  geodesy::GeodeticPoint scene_origin;
+  auto lat = origin_file->parseDouble(fields[0], "lat");
+  auto lon = origin_file->parseDouble(fields[1], "lon");
+  auto alt = origin_file->parseDouble(fields[2], "alt");
+  if (!lat || !lon || !alt) return !lat ? lat.status() : !lon ? lon.status() : alt.status();
+  scene_origin = {*lat, *lon, *alt};
+  auto scene = geodesy::LocalEnuFrame::create(scene_origin);
+  if (!scene) return scene.status();
+  auto fix = geodesy::LocalEnuFrame::create(data.origin);
+  if (!fix) return fix.status();
+  for (Isometry3& T : data.T_w_c_gt) {
+    auto g = scene->toGeodetic(T.translation());
+    if (!g) return g.status();
+    Eigen::Matrix3d C_scene_lev, C_fix_lev;
+    auto p_scene = scene->toEnu(*g, C_scene_lev);
+    auto p_fix = fix->toEnu(*g, C_fix_lev);
+    if (!p_scene || !p_fix) return !p_scene ? p_scene.status() : p_fix.status();
+    T.linear() = orthonormalize(C_fix_lev * C_scene_lev.transpose() * T.linear());
+    T.translation() = *p_fix;
+  }
   if (data.T_w_c_gt.size() != data.times_ns.size()) {
     return invalidArgument(options.drive_dir + ": gt/poses_cam0_enu.txt has " +
                            std::to_string(data.T_w_c_gt.size()) + " poses for " +

@@ -40,12 +40,13 @@ struct ReplayRun {
 };
 
 struct ReplayData {
-  std::vector<Isometry3> T_w_c_gt;  // ENU
+  std::vector<Isometry3> T_w_c_gt;  // camera 0 in the replay's world (ENU at the first GPS fix)
   std::vector<TimeNs> times_ns;
   geodesy::GeodeticPoint origin;
 };
 
-// Loads the ground truth of a drive (gt/poses_cam0_enu.txt, image_00/timestamps.txt).
+// Loads the ground truth of a drive (gt/poses_cam0_enu.txt in the ENU frame of gt/origin.txt,
+// moved into the world of the replay; image_00/timestamps.txt; the first OXTS fix).
 Expected<ReplayData> loadReplayData(const ReplayOptions& options);
 
 // One run: pure VO (spec == nullopt) or VO + sun from one source.
