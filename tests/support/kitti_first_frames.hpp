@@ -13,10 +13,7 @@
 
 namespace sunvo::testing {
 
-struct KittiFrames {
-  StereoCamera camera;              // rectified gray pair 0/1, with the image size
-  std::vector<StereoFrame> frames;  // left/right CV_8UC1, sequence = frame index
-};
+using KittiFrames = kitti::LoadedFrames;
 
 // Frame times only order the frames in these tests; times.txt's 0 is placed at 1 s after the
 // epoch (the odometry layout names no absolute time).
@@ -31,18 +28,7 @@ inline Expected<KittiFrames> loadKittiFirstFrames() {
   o.root = kittiFirstFramesDir();
   o.layout = kitti::KittiLayout::kOdometry;
   o.odometry_start_time_ns = kKittiFirstFramesStartNs;
-  auto src = kitti::KittiStereoSource::open(o);
-  if (!src) return src.status();
-  KittiFrames out;
-  out.camera = src->camera();
-  while (true) {
-    StereoFrame f;
-    const Status s = src->next(f);
-    if (src->finished()) break;
-    if (!s.isOk()) return s;
-    out.frames.push_back(std::move(f));
-  }
-  return out;
+  return kitti::loadAllFrames(o);
 }
 
 }  // namespace sunvo::testing

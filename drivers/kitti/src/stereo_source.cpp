@@ -319,4 +319,19 @@ Status KittiStereoSource::next(StereoFrame& out) {
   return Status::ok();
 }
 
+Expected<LoadedFrames> loadAllFrames(const KittiSourceOptions& options) {
+  auto source = KittiStereoSource::open(options);
+  if (!source) return source.status();
+  LoadedFrames out;
+  out.camera = source->camera();
+  while (true) {
+    StereoFrame frame;
+    const Status s = source->next(frame);
+    if (source->finished()) break;
+    SUNVO_RETURN_IF_ERROR(s);
+    out.frames.push_back(std::move(frame));
+  }
+  return out;
+}
+
 }  // namespace sunvo::kitti

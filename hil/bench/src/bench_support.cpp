@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <ctime>
@@ -21,19 +22,36 @@ Expected<KittiFrames> loadKittiOdometryFrames(const std::string& dir, TimeNs sta
   o.root = dir;
   o.layout = kitti::KittiLayout::kOdometry;
   o.odometry_start_time_ns = start_time_ns;
-  auto src = kitti::KittiStereoSource::open(o);
-  if (!src) return src.status();
-  KittiFrames out;
-  out.camera = src->camera();
-  while (true) {
-    StereoFrame f;
-    const Status s = src->next(f);
-    if (src->finished()) break;
-    if (!s.isOk()) return s;
-    out.frames.push_back(std::move(f));
-  }
-  if (out.frames.size() < 2) return invalidArgument(dir + ": fewer than 2 frames");
+  auto out = kitti::loadAllFrames(o);
+  if (!out) return out.status();
+  if (out->frames.size() < 2) return invalidArgument(dir + ": fewer than 2 frames");
   return out;
+}
+
+bool parseBenchFlag(const std::string& a, BenchConfig& config) {
+  if (a.rfind("--frames=", 0) == 0) {
+    config.frames = std::max(1, std::atoi(a.c_str() + 9));
+  } else if (a.rfind("--warmup=", 0) == 0) {
+    config.warmup = std::max(0, std::atoi(a.c_str() + 9));
+  } else if (a.rfind("--cpu=", 0) == 0) {
+    config.cpu = std::atoi(a.c_str() + 6);
+  } else if (a.rfind("--data=", 0) == 0) {
+    config.data = a.substr(7);
+  } else {
+    return false;
+  }
+  return true;
+}
+
+Status prepareBenchmark(const BenchConfig& config, bool alloc_counter_active) {
+  if (config.cpu >= 0) {
+    SUNVO_RETURN_IF_ERROR(pinToCpu(config.cpu));
+    std::printf("pinned to CPU %d\n", config.cpu);
+  }
+  if (!alloc_counter_active) {
+    return failedPrecondition("allocation counter is not active in this binary");
+  }
+  return Status::ok();
 }
 
 std::size_t pingPong(std::size_t i, std::size_t n) {

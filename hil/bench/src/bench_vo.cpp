@@ -41,12 +41,8 @@ using sunvo::bench::percentile;
 constexpr double kTargetMedianMs = 20.0;
 constexpr double kTargetP99Ms = 35.0;
 
-struct Config {
-  int frames = 500;
-  int warmup = 20;
-  std::string data = std::string(SUNVO_DATA_DIR) + "/kitti_odometry/00_first_frames";
+struct Config : sunvo::bench::BenchConfig {
   std::string tracks = std::string(SUNVO_DATA_DIR) + "/kitti_tracks/2011_09_30_drive_0020";
-  int cpu = -1;  // pin to this CPU when >= 0
 };
 
 struct Run {
@@ -357,30 +353,18 @@ int main(int argc, char** argv) {
   std::vector<char*> rest;
   for (int i = 0; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a.rfind("--frames=", 0) == 0) {
-      g_config.frames = std::max(1, std::atoi(a.c_str() + 9));
-    } else if (a.rfind("--warmup=", 0) == 0) {
-      g_config.warmup = std::max(0, std::atoi(a.c_str() + 9));
-    } else if (a.rfind("--cpu=", 0) == 0) {
-      g_config.cpu = std::atoi(a.c_str() + 6);
-    } else if (a.rfind("--data=", 0) == 0) {
-      g_config.data = a.substr(7);
+    if (sunvo::bench::parseBenchFlag(a, g_config)) {
+      continue;
     } else if (a.rfind("--tracks=", 0) == 0) {
       g_config.tracks = a.substr(9);
     } else {
       rest.push_back(argv[i]);
     }
   }
-  if (g_config.cpu >= 0) {
-    const sunvo::Status s = sunvo::bench::pinToCpu(g_config.cpu);
-    if (!s.isOk()) {
-      std::fprintf(stderr, "%s\n", s.toString().c_str());
-      return 1;
-    }
-    std::printf("pinned to CPU %d\n", g_config.cpu);
-  }
-  if (!sunvo::bench::allocCounterActive()) {
-    std::fprintf(stderr, "allocation counter is not active in this binary\n");
+  if (const sunvo::Status s =
+          sunvo::bench::prepareBenchmark(g_config, sunvo::bench::allocCounterActive());
+      !s.isOk()) {
+    std::fprintf(stderr, "%s\n", s.toString().c_str());
     return 1;
   }
   auto data = sunvo::bench::loadKittiOdometryFrames(g_config.data);

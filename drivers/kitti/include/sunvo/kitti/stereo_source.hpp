@@ -125,4 +125,12 @@ class KittiStereoSource {
   std::vector<unsigned char> file_buffer_;  // reused for every image file read
 };
 
+// Every frame of a recording decoded into memory, for tests and benchmarks (a few hundred frames
+// at most: 1241x376 gray pairs take about 0.9 MB each).
+struct LoadedFrames {
+  StereoCamera camera;              // rectified gray pair 0/1 with the image size
+  std::vector<StereoFrame> frames;  // in order; sequence = frame index
+};
+Expected<LoadedFrames> loadAllFrames(const KittiSourceOptions& options);
+
 }  // namespace sunvo::kitti

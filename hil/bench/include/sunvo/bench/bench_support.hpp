@@ -11,13 +11,24 @@
 #include "sunvo/core/status.hpp"
 #include "sunvo/core/stereo_frame.hpp"
 #include "sunvo/core/time.hpp"
+#include "sunvo/kitti/stereo_source.hpp"
 
 namespace sunvo::bench {
 
-struct KittiFrames {
-  StereoCamera camera;              // rectified gray pair 0/1 with the image size
-  std::vector<StereoFrame> frames;  // left/right CV_8UC1, sequence = frame index
+using KittiFrames = kitti::LoadedFrames;
+
+// Flags every benchmark takes: --frames=N --warmup=N --cpu=K --data=DIR.
+struct BenchConfig {
+  int frames = 500;  // timed frames, >= 1
+  int warmup = 20;   // frames before timing, >= 0
+  std::string data = std::string(SUNVO_DATA_DIR) + "/kitti_odometry/00_first_frames";
+  int cpu = -1;  // pin to this CPU when >= 0
 };
+// Consumes one of the common flags into `config`; false when `arg` is not one of them.
+bool parseBenchFlag(const std::string& arg, BenchConfig& config);
+// Pins to config.cpu (when >= 0); fails when the allocation counter is not linked in (the
+// caller passes bench::allocCounterActive(), which only benchmark executables link).
+Status prepareBenchmark(const BenchConfig& config, bool alloc_counter_active);
 
 // Reads every frame of a KITTI odometry sequence folder (calib.txt, times.txt, image_0/,
 // image_1/) into memory. times.txt's 0 is placed at start_time_ns (UTC ns, > 0): the odometry
