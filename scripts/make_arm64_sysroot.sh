@@ -124,16 +124,33 @@ done < <(find "${SYSROOT}" -path "${stamps}" -prune -o -type l -print0)
 echo "sysroot: made ${fixed} absolute symlinks relative"
 
 # --- alternatives the maintainer scripts would have set up -----------------------------------
-# libblas3/liblapack3 put the reference libraries under blas/ and lapack/ and rely on
-# update-alternatives for the names the linker and the loader look for.
+# libblas3/liblapack3/libatlas3-base put their libraries under blas/, lapack/ and atlas/ and rely
+# on update-alternatives for the names the linker and the loader look for. ATLAS is preferred when
+# present, as on the x86-64 hosts (Debian's priorities: ATLAS 35 over the reference 10).
 multiarch="${SYSROOT}/usr/lib/aarch64-linux-gnu"
 for lib in blas lapack; do
   for so in "lib${lib}.so.3" "lib${lib}.so"; do
-    if [ -e "${multiarch}/${lib}/${so}" ] && [ ! -e "${multiarch}/${so}" ]; then
-      ln -sfn "${lib}/${so}" "${multiarch}/${so}"
-    fi
+    for provider in atlas "${lib}"; do
+      if [ -e "${multiarch}/${provider}/${so}" ]; then
+        ln -sfn "${provider}/${so}" "${multiarch}/${so}"
+        break
+      fi
+    done
   done
 done
+
+# --- CMake package files ----------------------------------------------------------------------
+# Ceres' exported targets name LAPACK/BLAS by absolute path (/usr/lib/aarch64-linux-gnu/...),
+# which a cross build would look for on the host. Prefix them with ${CMAKE_SYSROOT}, which is
+# empty in a native build on the target, so the files stay valid there. Only paths following
+# '"' or ';' are rewritten, so a second run changes nothing.
+while IFS= read -r -d '' f; do
+  if grep -qE '[";]/usr/lib/aarch64-linux-gnu/' "${f}"; then
+    sed -i -E 's#([";])/usr/lib/aarch64-linux-gnu/#\1${CMAKE_SYSROOT}/usr/lib/aarch64-linux-gnu/#g' "${f}"
+    echo "sysroot: prefixed absolute library paths with \${CMAKE_SYSROOT} in ${f#"${SYSROOT}"/}"
+  fi
+done < <(find "${SYSROOT}/usr/lib/aarch64-linux-gnu/cmake" "${SYSROOT}/usr/lib/cmake" \
+  "${SYSROOT}/usr/share" -name '*Targets*.cmake' -print0 2>/dev/null)
 
 # --- check ------------------------------------------------------------------------------------
 for f in usr/include/eigen3/Eigen/Core usr/lib/aarch64-linux-gnu/cmake/opencv4/OpenCVConfig.cmake \
