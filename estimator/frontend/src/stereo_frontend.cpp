@@ -12,6 +12,8 @@
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
+#elif defined(__ARM_NEON) && defined(__aarch64__)
+#include <arm_neon.h>
 #endif
 
 namespace sunvo {
@@ -47,6 +49,13 @@ inline int sad32(const std::uint8_t* a, const std::uint8_t* b) {
   // psadbw leaves two 16-bit partial sums, in the low and the high 64-bit lane.
   const __m128i s = _mm_add_epi64(_mm_sad_epu8(a0, b0), _mm_sad_epu8(a1, b1));
   return _mm_cvtsi128_si32(_mm_add_epi64(s, _mm_unpackhi_epi64(s, s)));
+#elif defined(__ARM_NEON) && defined(__aarch64__)
+  // |a - b| per byte (vabdq_u8); vpaddlq_u8 adds neighbouring bytes into eight 16-bit lanes and
+  // vpadalq_u8 adds the second half's pairs on top (at most 4 x 255 per lane); vaddvq_u16 sums
+  // the lanes (at most 32 x 255 = 8160 < 2^16, so no lane or the total overflows).
+  const uint8x16_t d0 = vabdq_u8(vld1q_u8(a), vld1q_u8(b));
+  const uint8x16_t d1 = vabdq_u8(vld1q_u8(a + 16), vld1q_u8(b + 16));
+  return static_cast<int>(vaddvq_u16(vpadalq_u8(vpaddlq_u8(d0), d1)));
 #else
   int s = 0;
   for (int i = 0; i < StereoFrontend::kDescriptorBytes; ++i) s += std::abs(int{a[i]} - int{b[i]});
