@@ -34,7 +34,8 @@ std::string slurp(const std::string& path) {
 }
 
 CliResult runEval(const std::string& args) {
-  const std::string cmd = kExe + " " + args + " > " + kTmp + "stdout.txt 2> " + kTmp + "stderr.txt";
+  const std::string cmd = SUNVO_TOOL_EMULATOR + kExe + " " + args + " > " + kTmp +
+                          "stdout.txt 2> " + kTmp + "stderr.txt";
   const int status = std::system(cmd.c_str());
   CliResult r;
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;

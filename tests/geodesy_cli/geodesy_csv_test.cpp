@@ -84,7 +84,8 @@ TEST(GeodesyCli, ExitCodes) {
   std::ofstream(good) << "origin_lat,origin_lon,origin_alt,lat,lon,alt\n49,8,0,49,8.001,0\n";
   std::ofstream(bad) << "origin_lat,origin_lon,origin_alt,lat,lon,alt\n49,8,0,49,east,0\n";
   auto run = [&](const std::string& args) {
-    const int rc = std::system((exe + " " + args + " > " + out + " 2> " + err).c_str());
+    const int rc =
+        std::system((SUNVO_TOOL_EMULATOR + exe + " " + args + " > " + out + " 2> " + err).c_str());
     return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
   };
   auto slurp = [](const std::string& p) {

@@ -132,7 +132,8 @@ TEST(SunCsv, OptionsValidateNamesKey) {
 // The program itself: exit 0 and a CSV file on good input, exit 2 and a line/field message on
 // bad input.
 int runTool(const std::string& args, const std::string& err_path) {
-  const std::string tool = std::string(SUNVO_BINARY_DIR) + "/hil/sun_cli/sunvo_sun";
+  const std::string tool =
+      std::string(SUNVO_TOOL_EMULATOR) + SUNVO_BINARY_DIR + "/hil/sun_cli/sunvo_sun";
   const int rc = std::system((tool + " " + args + " 2>'" + err_path + "'").c_str());
   return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
 }
