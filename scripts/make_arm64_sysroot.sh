@@ -146,6 +146,7 @@ done
 # '"' or ';' are rewritten, so a second run changes nothing.
 while IFS= read -r -d '' f; do
   if grep -qE '[";]/usr/lib/aarch64-linux-gnu/' "${f}"; then
+    # shellcheck disable=SC2016  # ${CMAKE_SYSROOT} is literal text for CMake, not for the shell
     sed -i -E 's#([";])/usr/lib/aarch64-linux-gnu/#\1${CMAKE_SYSROOT}/usr/lib/aarch64-linux-gnu/#g' "${f}"
     echo "sysroot: prefixed absolute library paths with \${CMAKE_SYSROOT} in ${f#"${SYSROOT}"/}"
   fi
