@@ -80,17 +80,20 @@ qemu-aarch64 -L "${SUNVO_SYSROOT}" build/aarch64/hil/track_vo/sunvo_track_vo "${
   "${OUT}/poses_aarch64.txt" "${args[@]}" >"${OUT}/track_vo_aarch64.log"
 echo "test_arm64: aarch64 (qemu) track_vo $(elapsed "${t0}") s"
 
-# KITTI pose lines: r11 r12 r13 tx r21 r22 r23 ty r31 r32 r33 tz. Position difference |t_a - t_b|;
-# rotation difference angle(R_a^T R_b) = acos((trace(R_a^T R_b) - 1) / 2), trace(R_a^T R_b) =
-# sum over i, j of R_a(i,j) R_b(i,j).
+# KITTI pose lines: r11 r12 r13 tx r21 r22 r23 ty r31 r32 r33 tz. Position difference |t_a - t_b|.
+# Rotation difference theta = angle(R_a^T R_b) from the Frobenius norm of R_a - R_b:
+# |R_a - R_b|_F^2 = 2 (3 - trace(R_a^T R_b)) = 2 (2 - 2 cos theta) = 8 sin^2(theta / 2), so
+# theta = 2 asin(|R_a - R_b|_F / (2 sqrt 2)); unlike acos((trace - 1) / 2) this resolves angles
+# far below 1e-8 rad.
 paste -d' ' "${OUT}/poses_x86_64.txt" "${OUT}/poses_aarch64.txt" | awk -v tol="${TOLERANCE_M}" '
   NF != 24 { print "test_arm64: malformed pose line " NR; bad = 1; exit 1 }
   {
     dx = $4 - $16; dy = $8 - $20; dz = $12 - $24
     d = sqrt(dx * dx + dy * dy + dz * dz)
-    tr = $1 * $13 + $2 * $14 + $3 * $15 + $5 * $17 + $6 * $18 + $7 * $19 + $9 * $21 + $10 * $22 + $11 * $23
-    c = (tr - 1) / 2; if (c > 1) c = 1; if (c < -1) c = -1
-    a = atan2(sqrt(1 - c * c), c) * 180 / 3.141592653589793
+    f2 = 0
+    for (i = 1; i <= 11; ++i) if (i % 4 != 0) f2 += ($i - $(i + 12)) ^ 2
+    h = sqrt(f2) / (2 * sqrt(2)); if (h > 1) h = 1
+    a = 2 * atan2(h, sqrt(1 - h * h)) * 180 / 3.141592653589793
     if (d > dmax) { dmax = d; kmax = NR - 1 }
     if (a > amax) amax = a
     if (d > 0 && first < 0) first = NR - 1
