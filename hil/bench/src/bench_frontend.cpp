@@ -180,13 +180,7 @@ int main(int argc, char** argv) {
       rest.push_back(argv[i]);
     }
   }
-  if (const sunvo::Status s =
-          sunvo::bench::prepareBenchmark(g_config, sunvo::bench::allocCounterActive());
-      !s.isOk()) {
-    std::fprintf(stderr, "%s\n", s.toString().c_str());
-    return 1;
-  }
-  auto sample = sunvo::bench::loadKittiOdometryFrames(g_config.data);
+  auto sample = sunvo::bench::prepareBenchmark(g_config, sunvo::bench::allocCounterActive());
   if (!sample) {
     std::fprintf(stderr, "%s\n", sample.status().toString().c_str());
     return 1;

@@ -43,7 +43,7 @@ bool parseBenchFlag(const std::string& a, BenchConfig& config) {
   return true;
 }
 
-Status prepareBenchmark(const BenchConfig& config, bool alloc_counter_active) {
+Expected<KittiFrames> prepareBenchmark(const BenchConfig& config, bool alloc_counter_active) {
   if (config.cpu >= 0) {
     SUNVO_RETURN_IF_ERROR(pinToCpu(config.cpu));
     std::printf("pinned to CPU %d\n", config.cpu);
@@ -51,7 +51,7 @@ Status prepareBenchmark(const BenchConfig& config, bool alloc_counter_active) {
   if (!alloc_counter_active) {
     return failedPrecondition("allocation counter is not active in this binary");
   }
-  return Status::ok();
+  return loadKittiOdometryFrames(config.data);
 }
 
 std::size_t pingPong(std::size_t i, std::size_t n) {

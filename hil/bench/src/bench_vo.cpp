@@ -361,13 +361,7 @@ int main(int argc, char** argv) {
       rest.push_back(argv[i]);
     }
   }
-  if (const sunvo::Status s =
-          sunvo::bench::prepareBenchmark(g_config, sunvo::bench::allocCounterActive());
-      !s.isOk()) {
-    std::fprintf(stderr, "%s\n", s.toString().c_str());
-    return 1;
-  }
-  auto data = sunvo::bench::loadKittiOdometryFrames(g_config.data);
+  auto data = sunvo::bench::prepareBenchmark(g_config, sunvo::bench::allocCounterActive());
   if (!data) {
     std::fprintf(stderr, "%s\n", data.status().toString().c_str());
     return 1;

@@ -26,9 +26,10 @@ struct BenchConfig {
 };
 // Consumes one of the common flags into `config`; false when `arg` is not one of them.
 bool parseBenchFlag(const std::string& arg, BenchConfig& config);
-// Pins to config.cpu (when >= 0); fails when the allocation counter is not linked in (the
-// caller passes bench::allocCounterActive(), which only benchmark executables link).
-Status prepareBenchmark(const BenchConfig& config, bool alloc_counter_active);
+// Pins to config.cpu (when >= 0), fails when the allocation counter is not linked in (the
+// caller passes bench::allocCounterActive(), which only benchmark executables link), and loads
+// the frames of config.data.
+Expected<KittiFrames> prepareBenchmark(const BenchConfig& config, bool alloc_counter_active);
 
 // Reads every frame of a KITTI odometry sequence folder (calib.txt, times.txt, image_0/,
 // image_1/) into memory. times.txt's 0 is placed at start_time_ns (UTC ns, > 0): the odometry
