@@ -187,6 +187,8 @@ TEST(KittiStereoSource, RawLayoutWithColour) {
   auto src = KittiStereoSource::open(drive.options(true));
   ASSERT_TRUE(src) << src.status().toString();
   EXPECT_EQ(src->layout(), KittiLayout::kRaw);
+  // Calibration comes from the drive's parent (the date folder), as the raw layout has it.
+  EXPECT_EQ(fs::path(src->calibrationDir()).filename(), "2011_09_26");
   EXPECT_DOUBLE_EQ(src->camera().fu, 721.5377);
   ASSERT_TRUE(src->colorCamera().has_value());
   EXPECT_NEAR(src->colorCamera()->baseline_m, 0.5327, 1e-4);

@@ -104,12 +104,12 @@ Status KittiStereoSource::openRaw() {
   }
   fs::path root = fs::path(options_.root).lexically_normal();
   if (!root.has_filename()) root = root.parent_path();
-  std::string calib_dir = options_.calib_dir;
-  if (calib_dir.empty()) {
-    calib_dir = root.parent_path().string();
-    if (calib_dir.empty()) calib_dir = ".";
+  calib_dir_ = options_.calib_dir;
+  if (calib_dir_.empty()) {
+    calib_dir_ = root.parent_path().string();
+    if (calib_dir_.empty()) calib_dir_ = ".";
   }
-  auto c2c = readCamToCam(calib_dir + "/calib_cam_to_cam.txt");
+  auto c2c = readCamToCam(calib_dir_ + "/calib_cam_to_cam.txt");
   if (!c2c) return c2c.status();
   auto cam = rawStereoCamera(*c2c, 0, 1);
   if (!cam) return cam.status();

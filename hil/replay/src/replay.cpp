@@ -23,11 +23,6 @@ double percentile(std::vector<double> v, double p) {
   return v[static_cast<std::size_t>(std::lround(p / 100.0 * static_cast<double>(v.size() - 1)))];
 }
 
-std::string parentOf(const std::string& dir) {
-  const std::size_t slash = dir.find_last_of('/', dir.size() > 1 ? dir.size() - 2 : 0);
-  return slash == std::string::npos ? "." : dir.substr(0, slash);
-}
-
 }  // namespace
 
 Status ReplayOptions::validate() const {
@@ -109,7 +104,7 @@ Expected<ReplayRun> replayDrive(const ReplayOptions& options,
   const kitti::OxtsRecord& first = oxts->front().record;
   auto world = geodesy::LocalEnuFrame::create({first.lat, first.lon, first.alt});
   if (!world) return world.status();
-  auto calib = kitti::readRawCalibration(parentOf(options.drive_dir));
+  auto calib = kitti::readRawCalibration(source->calibrationDir());
   if (!calib) return calib.status();
   const Isometry3 T_c0rect_imu =
       geodesy::cam0RectFromImu(calib->cam_to_cam.cameras[0].R_rect, calib->velo_to_cam.transform(),

@@ -101,6 +101,9 @@ class KittiStereoSource {
   const std::vector<TimeNs>& frameTimes() const { return times_ns_; }
   // Image path of camera 0..3 for frame `index`.
   std::string imagePath(int camera, std::int64_t index) const;
+  // Raw layout: the folder the calibration files were read from (calib_dir, or the drive's
+  // parent folder); empty for the odometry layout.
+  const std::string& calibrationDir() const { return calib_dir_; }
 
  private:
   KittiStereoSource() = default;
@@ -115,6 +118,7 @@ class KittiStereoSource {
   StereoCamera camera_;
   std::optional<StereoCamera> color_camera_;
   std::vector<TimeNs> times_ns_;
+  std::string calib_dir_;
   std::int64_t first_ = 0;
   std::int64_t last_ = 0;
   std::int64_t next_index_ = 0;
