@@ -166,6 +166,18 @@ TEST(Validation, RejectsBadInput) {
   EXPECT_NE(eo.validate().message().find("rpe_distance_m"), std::string::npos);
 }
 
+TEST(Percentile, NearestIndexWithoutInterpolation) {
+  EXPECT_EQ(percentile({}, 0.5), 0.0);
+  EXPECT_EQ(percentile({5.0, 1.0, 3.0}, 0.5), 3.0);
+  EXPECT_EQ(percentile({4.0, 1.0, 2.0, 3.0}, 0.5), 3.0);  // index round(1.5) = 2
+  std::vector<double> v;
+  for (int i = 0; i < 101; ++i) v.push_back(100.0 - i);  // 100 .. 0, unsorted order
+  EXPECT_EQ(percentile(v, 0.99), 99.0);
+  EXPECT_EQ(percentile(v, 0.0), 0.0);
+  EXPECT_EQ(percentile(v, 1.0), 100.0);
+  EXPECT_EQ(percentile(v, 2.0), 100.0);  // q clamped to [0, 1]
+}
+
 TEST(ErrorStats, MedianRmseMeanMax) {
   const ErrorStats odd = summarize({3.0, 1.0, 2.0});
   EXPECT_EQ(odd.median, 2.0);

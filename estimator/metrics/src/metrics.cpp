@@ -56,6 +56,14 @@ std::pair<int, int> planeAxes(HorizontalPlane plane) {
   return plane == HorizontalPlane::kEastNorth ? std::pair{0, 1} : std::pair{0, 2};
 }
 
+double percentile(std::vector<double> values, double q) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  const double clamped = std::clamp(q, 0.0, 1.0);
+  return values[static_cast<std::size_t>(
+      std::lround(clamped * static_cast<double>(values.size() - 1)))];
+}
+
 ErrorStats summarize(std::vector<double> errors) {
   ErrorStats s;
   s.count = errors.size();

@@ -14,14 +14,6 @@
 namespace sunvo::experiment {
 namespace {
 
-double percentile(std::vector<double> v, double p) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const auto i =
-      static_cast<std::size_t>(std::lround(p / 100.0 * static_cast<double>(v.size() - 1)));
-  return v[i];
-}
-
 // The first camera frame of KITTI is level to within a few degrees: up is its -y axis.
 const Eigen::Vector3d kCameraWorldUp(0.0, -1.0, 0.0);
 
@@ -85,8 +77,8 @@ Expected<RunResult> runRoute(const Route& route, const std::optional<SunSourceSp
     result.T_w_c.push_back(r->T_w_c);
   }
   result.gate = sun_term.counters();
-  result.median_ms = percentile(ms, 50.0);
-  result.p99_ms = percentile(ms, 99.0);
+  result.median_ms = metrics::percentile(ms, 0.5);
+  result.p99_ms = metrics::percentile(ms, 0.99);
   const std::vector<Isometry3> gt(route.T_w_c_gt.begin(),
                                   route.T_w_c_gt.begin() + static_cast<std::ptrdiff_t>(n));
   metrics::EvaluationOptions eval_opt;

@@ -1,9 +1,5 @@
 #include "sunvo/replay/replay.hpp"
 
-#include <algorithm>
-#include <chrono>
-#include <cmath>
-
 #include "sunvo/files/sun_csv.hpp"
 #include "sunvo/files/text_file.hpp"
 #include "sunvo/files/trajectory_io.hpp"
@@ -15,15 +11,6 @@
 #include "sunvo/sun/spa.hpp"
 
 namespace sunvo::replay {
-namespace {
-
-double percentile(std::vector<double> v, double p) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v[static_cast<std::size_t>(std::lround(p / 100.0 * static_cast<double>(v.size() - 1)))];
-}
-
-}  // namespace
 
 Status ReplayOptions::validate() const {
   if (drive_dir.empty()) return invalidArgument("replay.drive_dir is empty");
@@ -162,8 +149,8 @@ Expected<ReplayRun> replayDrive(const ReplayOptions& options,
     run.T_w_c.push_back(r->vo.T_w_c);
   }
   run.gate = sun_term.counters();
-  run.median_ms = percentile(ms, 50.0);
-  run.p99_ms = percentile(ms, 99.0);
+  run.median_ms = metrics::percentile(ms, 0.5);
+  run.p99_ms = metrics::percentile(ms, 0.99);
   return run;
 }
 

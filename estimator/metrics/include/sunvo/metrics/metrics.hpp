@@ -43,6 +43,11 @@ struct ErrorStats {
 };
 ErrorStats summarize(std::vector<double> errors);
 
+// The q-quantile (q in [0, 1]) of `values` as the sorted element at index round(q (n - 1)), no
+// interpolation (q = 0.5 of an even count takes the upper middle); 0 when empty. Used for timing
+// summaries (median, p99).
+double percentile(std::vector<double> values, double q);
+
 // Paper Table 1. Both trajectories are taken relative to their own first pose, with no
 // alignment, and the estimate is re-anchored on the ground truth's first pose so that the
 // horizontal plane keeps its meaning in the world frame:
