@@ -12,8 +12,10 @@
 
 #include <atomic>
 #include <chrono>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <new>
 #include <thread>
 #include <vector>
 
