@@ -12,44 +12,15 @@
 #include <iostream>
 #include <vector>
 
+#include "../support/telemetry.hpp"
+
 namespace sunvo::mavlink {
 namespace {
 
-Odometry fullOdometry() {
-  Odometry m;
-  m.time_usec = 1'317'380'000'123'456ULL;
-  m.frame_id = kMavFrameLocalNed;
-  m.child_frame_id = kMavFrameBodyFrd;
-  m.x = 12.5f;
-  m.y = -3.25f;
-  m.z = 0.125f;
-  m.q = {0.9238795f, 0.0f, 0.0f, 0.3826834f};
-  m.vx = 1.5f;
-  m.vy = -0.5f;
-  m.vz = 0.01f;
-  m.rollspeed = 0.001f;
-  m.pitchspeed = -0.002f;
-  m.yawspeed = 0.1f;
-  for (std::size_t i = 0; i < 21; ++i) {
-    m.pose_covariance[i] = 0.01f * static_cast<float>(i + 1);
-    m.velocity_covariance[i] = -0.5f * static_cast<float>(i + 1);
-  }
-  m.reset_counter = 3;
-  m.estimator_type = kMavEstimatorVision;
-  m.quality = 87;
-  return m;
-}
+using sunvo::testing::sampleOdometry;
 
 std::vector<Frame> decodeAll(Decoder& decoder, const std::vector<std::uint8_t>& bytes) {
-  std::vector<Frame> frames;
-  Frame f;
-  for (std::uint8_t b : bytes) {
-    if (decoder.push(b, &f)) {
-      frames.push_back(f);
-      while (decoder.next(&f)) frames.push_back(f);
-    }
-  }
-  return frames;
+  return sunvo::testing::decodeAll(bytes, &decoder);
 }
 
 void expectSameOdometry(const Odometry& a, const Odometry& b) {
@@ -107,7 +78,7 @@ TEST(Encode, HeartbeatHeaderPayloadAndCrc) {
 
 TEST(Encode, OdometryMsgIdIs24BitLittleEndian) {
   std::uint8_t buf[kMaxFrameBytes];
-  const std::size_t n = encodeOdometry(fullOdometry(), Endpoint{}, 0, buf);
+  const std::size_t n = encodeOdometry(sampleOdometry(), Endpoint{}, 0, buf);
   EXPECT_EQ(n, kHeaderBytes + kPayloadBytesOdometry + kChecksumBytes);  // quality != 0: no cut
   EXPECT_EQ(buf[7], 331 & 0xFF);
   EXPECT_EQ(buf[8], 331 >> 8);
@@ -115,14 +86,14 @@ TEST(Encode, OdometryMsgIdIs24BitLittleEndian) {
   // time_usec leads the payload (largest type first), frame ids follow the float arrays.
   std::uint64_t t = 0;
   for (int i = 0; i < 8; ++i) t |= static_cast<std::uint64_t>(buf[kHeaderBytes + i]) << (8 * i);
-  EXPECT_EQ(t, fullOdometry().time_usec);
+  EXPECT_EQ(t, sampleOdometry().time_usec);
   EXPECT_EQ(buf[kHeaderBytes + 228], kMavFrameLocalNed);
   EXPECT_EQ(buf[kHeaderBytes + 229], kMavFrameBodyFrd);
   EXPECT_EQ(buf[kHeaderBytes + 232], 87);
 }
 
 TEST(Encode, TrailingZeroBytesAreCutAndRestoredByTheDecoder) {
-  Odometry m = fullOdometry();
+  Odometry m = sampleOdometry();
   m.quality = 0;
   m.estimator_type = 0;
   m.reset_counter = 0;
@@ -160,7 +131,7 @@ TEST(Decoder, RoundTripsAStreamOfBothMessagesFedByteByByte) {
       const std::size_t n = encodeHeartbeat(hb, Endpoint{}, seq++, buf);
       stream.insert(stream.end(), buf, buf + n);
     }
-    Odometry m = fullOdometry();
+    Odometry m = sampleOdometry();
     m.time_usec += static_cast<std::uint64_t>(i) * 100'000;
     m.x = static_cast<float>(i);
     m.quality = static_cast<std::int8_t>(i * 9 - 1);
@@ -197,9 +168,9 @@ TEST(Decoder, RoundTripsAStreamOfBothMessagesFedByteByByte) {
 
 TEST(Decoder, ResynchronisesAfterGarbageAndCorruptFrames) {
   std::uint8_t a[kMaxFrameBytes], b[kMaxFrameBytes], c[kMaxFrameBytes];
-  const std::size_t na = encodeOdometry(fullOdometry(), Endpoint{}, 10, a);
+  const std::size_t na = encodeOdometry(sampleOdometry(), Endpoint{}, 10, a);
   const std::size_t nb = encodeHeartbeat(Heartbeat{}, Endpoint{}, 11, b);
-  const std::size_t nc = encodeOdometry(fullOdometry(), Endpoint{}, 12, c);
+  const std::size_t nc = encodeOdometry(sampleOdometry(), Endpoint{}, 12, c);
   std::vector<std::uint8_t> stream = {0x00, 0x55, 0xFE, 0x13};  // noise, incl. a v1 start byte
   // A corrupt frame: one payload bit flipped.
   a[40] ^= 0x10;
@@ -237,7 +208,7 @@ TEST(Decoder, CountsUnknownMessagesSignedFramesAndSequenceGaps) {
   for (std::size_t i = 0; i < kSignatureBytes; ++i) buf[n1++] = static_cast<std::uint8_t>(0xA0 + i);
   stream.insert(stream.end(), buf, buf + n1);
   // seq 5 -> 9: three frames missing.
-  const std::size_t n2 = encodeOdometry(fullOdometry(), Endpoint{}, 9, buf);
+  const std::size_t n2 = encodeOdometry(sampleOdometry(), Endpoint{}, 9, buf);
   stream.insert(stream.end(), buf, buf + n2);
   Decoder decoder;
   const auto frames = decodeAll(decoder, stream);
@@ -252,7 +223,7 @@ TEST(Decoder, CountsUnknownMessagesSignedFramesAndSequenceGaps) {
 
 TEST(Encode, OdometryEncodeTimePerFrame) {
   // Reports the encode cost for docs/telemetry.md; the bound only catches gross regressions.
-  Odometry m = fullOdometry();
+  Odometry m = sampleOdometry();
   std::uint8_t buf[kMaxFrameBytes];
   constexpr int kFrames = 200'000;
   std::size_t bytes = 0;

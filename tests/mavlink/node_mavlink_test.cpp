@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "../support/pty.hpp"
+#include "../support/telemetry.hpp"
 #include "sunvo/mavlink/conventions.hpp"
 #include "sunvo/mavlink/mavlink.hpp"
 #include "sunvo/serial/serial_port.hpp"
@@ -130,27 +131,7 @@ std::string hex(const std::uint8_t* data, std::size_t n) {
   return s;
 }
 
-Odometry sampleOdometry() {
-  Odometry m;
-  m.time_usec = 1'317'380'000'123'456ULL;
-  m.x = 12.5f;
-  m.y = -3.25f;
-  m.z = 0.1f;
-  m.q = {0.9238795f, 0.01f, -0.02f, 0.3826834f};
-  m.vx = 1.5f;
-  m.vy = -0.5f;
-  m.vz = 0.01f;
-  m.rollspeed = 0.001f;
-  m.pitchspeed = -0.002f;
-  m.yawspeed = 0.1f;
-  for (std::size_t i = 0; i < 21; ++i) {
-    m.pose_covariance[i] = 1e-3f * static_cast<float>(i + 1);
-    m.velocity_covariance[i] = -0.25f * static_cast<float>(i);
-  }
-  m.reset_counter = 2;
-  m.quality = 73;
-  return m;
-}
+using sunvo::testing::sampleOdometry;
 
 TEST(NodeMavlink, EncoderMatchesNodeMavlinkSerializerByteForByte) {
   ensureNodeMavlink();

@@ -7,7 +7,6 @@
 
 #include <gtest/gtest.h>
 #include <termios.h>
-#include <time.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -20,6 +19,7 @@
 #include <vector>
 
 #include "../support/pty.hpp"
+#include "../support/telemetry.hpp"
 #include "sunvo/mavlink/mavlink.hpp"
 
 namespace sunvo::serial {
@@ -27,10 +27,15 @@ namespace {
 
 using sunvo::testing::PseudoTerminal;
 
-TimeNs monotonicNs() {
-  timespec ts{};
-  ::clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<TimeNs>(ts.tv_sec) * kNsPerSecond + ts.tv_nsec;
+using sunvo::testing::decodeAll;
+using sunvo::testing::monotonicNs;
+
+// Options for a port on the slave side of pty.
+SerialOptions optionsFor(const PseudoTerminal& pty, std::size_t tx_buffer_bytes = 16384) {
+  SerialOptions o;
+  o.device = pty.slavePath();
+  o.tx_buffer_bytes = tx_buffer_bytes;
+  return o;
 }
 
 std::vector<std::uint8_t> odometryFrame(std::uint8_t seq, float x) {
@@ -41,19 +46,6 @@ std::vector<std::uint8_t> odometryFrame(std::uint8_t seq, float x) {
   std::vector<std::uint8_t> frame(mavlink::kMaxFrameBytes);
   frame.resize(mavlink::encodeOdometry(m, mavlink::Endpoint{}, seq, frame.data()));
   return frame;
-}
-
-std::vector<mavlink::Frame> decodeAll(const std::vector<std::uint8_t>& bytes,
-                                      mavlink::Decoder* decoder) {
-  std::vector<mavlink::Frame> frames;
-  mavlink::Frame f;
-  for (std::uint8_t b : bytes) {
-    if (decoder->push(b, &f)) {
-      frames.push_back(f);
-      while (decoder->next(&f)) frames.push_back(f);
-    }
-  }
-  return frames;
 }
 
 TEST(SerialOptions, ValidateNamesTheBadKey) {
@@ -89,8 +81,7 @@ TEST(SerialPort, OpenFailsClearlyOnMissingDeviceOrNonTerminal) {
 TEST(SerialPort, SetsRawModeAndSpeedAndPassesEveryByteUnchanged) {
   PseudoTerminal pty;
   ASSERT_TRUE(pty.ok()) << pty.error();
-  SerialOptions o;
-  o.device = pty.slavePath();
+  SerialOptions o = optionsFor(pty);
   o.baud = 115200;
   auto port = SerialPort::open(o);
   ASSERT_TRUE(port) << port.status().toString();
@@ -121,10 +112,7 @@ TEST(SerialPort, SetsRawModeAndSpeedAndPassesEveryByteUnchanged) {
 TEST(SerialPort, SlowReaderNeverBlocksAndFramesAreDroppedWhole) {
   PseudoTerminal pty;
   ASSERT_TRUE(pty.ok()) << pty.error();
-  SerialOptions o;
-  o.device = pty.slavePath();
-  o.tx_buffer_bytes = 4096;
-  auto port = SerialPort::open(o);
+  auto port = SerialPort::open(optionsFor(pty, 4096));
   ASSERT_TRUE(port) << port.status().toString();
   // Nobody reads the master: the kernel's pty buffer fills, then the ring, then frames drop.
   constexpr int kFrames = 3000;
@@ -175,10 +163,7 @@ TEST(SerialPort, SlowReaderNeverBlocksAndFramesAreDroppedWhole) {
 TEST(SerialPort, RejectsAFrameLargerThanTheRing) {
   PseudoTerminal pty;
   ASSERT_TRUE(pty.ok()) << pty.error();
-  SerialOptions o;
-  o.device = pty.slavePath();
-  o.tx_buffer_bytes = 128;
-  auto port = SerialPort::open(o);
+  auto port = SerialPort::open(optionsFor(pty, 128));
   ASSERT_TRUE(port) << port.status().toString();
   const auto frame = odometryFrame(1, 1.0f);
   const Status s = (*port)->send(frame.data(), frame.size(), monotonicNs());
@@ -264,8 +249,7 @@ TEST(SerialPort, LostDeviceIsCountedAndReopenedWithBackoff) {
 double streamThroughput(int baud, int n_frames) {
   PseudoTerminal pty;
   EXPECT_TRUE(pty.ok()) << pty.error();
-  SerialOptions o;
-  o.device = pty.slavePath();
+  SerialOptions o = optionsFor(pty);
   o.baud = baud;
   auto port = SerialPort::open(o);
   EXPECT_TRUE(port) << port.status().toString();

@@ -3,11 +3,11 @@
 // Counted with the process-wide malloc shim of hil/bench (not available in sanitizer builds).
 
 #include <gtest/gtest.h>
-#include <time.h>
 
 #include <vector>
 
 #include "../support/pty.hpp"
+#include "../support/telemetry.hpp"
 #include "sunvo/bench/alloc_counter.hpp"
 #include "sunvo/mavlink/conventions.hpp"
 #include "sunvo/mavlink/mavlink.hpp"
@@ -18,11 +18,7 @@ namespace {
 
 using sunvo::testing::PseudoTerminal;
 
-TimeNs monotonicNs() {
-  timespec ts{};
-  ::clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<TimeNs>(ts.tv_sec) * kNsPerSecond + ts.tv_nsec;
-}
+using sunvo::testing::monotonicNs;
 
 TEST(TelemetryAlloc, CounterIsActive) {
   EXPECT_TRUE(bench::allocCounterActive());

@@ -10,10 +10,6 @@ float toFloat(double v) {
   return static_cast<float>(v);
 }
 
-bool allFiniteVec(const Eigen::Vector3d& v) {
-  return v.allFinite();
-}
-
 }  // namespace
 
 Eigen::Matrix3d cameraForwardC_b_c() {
@@ -82,14 +78,14 @@ Odometry toOdometry(const OdometryInput& in, WorldConvention world, const Eigen:
   out.q = {toFloat(q_l_b.w()), toFloat(q_l_b.x()), toFloat(q_l_b.y()), toFloat(q_l_b.z())};
 
   // Velocity in body FRD: v_b = C_b_w v_w = C_b_c C_c_w v_w. NaN input stays NaN (= unknown).
-  const Eigen::Vector3d v_b = allFiniteVec(in.v_w)
+  const Eigen::Vector3d v_b = in.v_w.allFinite()
                                   ? Eigen::Vector3d(C_b_c * C_w_c.transpose() * in.v_w)
                                   : Eigen::Vector3d::Constant(nan);
   out.vx = toFloat(v_b.x());
   out.vy = toFloat(v_b.y());
   out.vz = toFloat(v_b.z());
-  const Eigen::Vector3d omega_b = allFiniteVec(in.omega_c) ? Eigen::Vector3d(C_b_c * in.omega_c)
-                                                           : Eigen::Vector3d::Constant(nan);
+  const Eigen::Vector3d omega_b =
+      in.omega_c.allFinite() ? Eigen::Vector3d(C_b_c * in.omega_c) : Eigen::Vector3d::Constant(nan);
   out.rollspeed = toFloat(omega_b.x());
   out.pitchspeed = toFloat(omega_b.y());
   out.yawspeed = toFloat(omega_b.z());
