@@ -4,14 +4,20 @@
 // top-view plot.
 //
 // Usage: sunvo_replay --drive DIR [--out DIR] [--frames N] [--every N] [--seed N]
-//                     [--drift-deg D] [--paper-form]
+//                     [--drift-deg D] [--paper-form] [--poses]
+//
+// --poses also writes each run's estimated T_w_c as a KITTI pose file,
+// OUT/replay_poses_<run>.txt (run: pure_vo, vo_sun_true_vector, ...), for comparing replays
+// across builds (scripts/test_arm64.sh compares x86-64 with aarch64).
 
+#include <cctype>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <string>
 #include <vector>
 
+#include "sunvo/files/trajectory_io.hpp"
 #include "sunvo/metrics/metrics.hpp"
 #include "sunvo/replay/replay.hpp"
 #include "sunvo/report/report_files.hpp"
@@ -22,7 +28,7 @@ int usage(const std::string& msg) {
   std::fprintf(stderr, "sunvo_replay: %s\n", msg.c_str());
   std::fprintf(stderr,
                "usage: sunvo_replay --drive DIR [--out DIR] [--frames N] [--every N] [--seed N] "
-               "[--drift-deg D] [--paper-form]\n");
+               "[--drift-deg D] [--paper-form] [--poses]\n");
   return 2;
 }
 
@@ -34,12 +40,28 @@ bool parseCount(const char* text, int& out) {
   return true;
 }
 
+// "VO+Sun (true vector)" -> "vo_sun_true_vector": lower-case letters and digits, one '_' for
+// each run of anything else, none at the ends.
+std::string fileSlug(const std::string& name) {
+  std::string slug;
+  for (const char c : name) {
+    if (std::isalnum(static_cast<unsigned char>(c)) != 0) {
+      slug += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    } else if (!slug.empty() && slug.back() != '_') {
+      slug += '_';
+    }
+  }
+  while (!slug.empty() && slug.back() == '_') slug.pop_back();
+  return slug;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   sunvo::replay::ReplayOptions options;
   std::string out_dir = "replay_out";
   int seed = 1;
+  bool write_poses = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     const bool has_value = i + 1 < argc;
@@ -57,6 +79,8 @@ int main(int argc, char** argv) {
       options.fusion.attitude_drift_deg_per_frame = std::strtod(argv[++i], nullptr);
     } else if (a == "--paper-form") {
       options.fusion.estimate_base_attitude = false;
+    } else if (a == "--poses") {
+      write_poses = true;
     } else {
       return usage("unknown or incomplete argument '" + a + "'");
     }
@@ -95,6 +119,15 @@ int main(int argc, char** argv) {
                  run->name.c_str(), run->T_w_c.size(), run->median_ms, run->p99_ms,
                  run->lost_frames, static_cast<unsigned long long>(run->gate.accepted),
                  static_cast<unsigned long long>(run->gate.total()));
+    if (write_poses) {
+      const std::string path = out_dir + "/replay_poses_" + fileSlug(run->name) + ".txt";
+      sunvo::files::Trajectory trajectory;
+      trajectory.T_w_c = run->T_w_c;
+      if (auto s = sunvo::files::writeKittiPoses(path, trajectory); !s.isOk()) {
+        std::fprintf(stderr, "sunvo_replay: %s\n", s.toString().c_str());
+        return 1;
+      }
+    }
     input.num_poses = run->T_w_c.size();
     input.estimates.push_back({run->name, "", *ev});
     series.push_back({run->name, run->T_w_c});
