@@ -43,6 +43,7 @@ bad() {
   echo "check_deb: FAIL: $*"
   fail=1
 }
+words() { tr '\n' ' ' <<<"$1"; }  # a list, one item a line, on one line
 WORK="$(mktemp -d)"
 trap 'rm -rf "${WORK}"' EXIT
 
@@ -64,7 +65,7 @@ dpkg-deb -x "${DEB}" "${WORK}/root"
 etc_files="$(cd "${WORK}/root" && find etc -type f 2>/dev/null | sed 's|^|/|' | sort)"
 conffiles="$(sort "${WORK}/control/conffiles" 2>/dev/null || true)"
 [ "${etc_files}" = "${conffiles}" ] ||
-  bad "conffiles ($(echo ${conffiles})) differ from the files under /etc ($(echo ${etc_files}))"
+  bad "conffiles ($(words "${conffiles}")) differ from the files under /etc ($(words "${etc_files}"))"
 
 # --- 2. contents -------------------------------------------------------------------------------
 programs=(sunvo_replay sunvo_eval sunvo_sun sunvo_geodesy sunvo_kitti_replay sunvo_track_vo)
@@ -150,7 +151,7 @@ derived="$(sort -u <<<"${derived}")"
 depends="$(field Depends)"
 declared="$(tr ',' '\n' <<<"${depends}" | sed 's/^ *//; s/ *(.*//' | sort -u)"
 [ "${derived}" = "${declared}" ] ||
-  bad "Depends names ($(echo ${declared})) differ from the packages the programs need ($(echo ${derived}))"
+  bad "Depends names ($(words "${declared}")) differ from the packages the programs need ($(words "${derived}"))"
 while IFS= read -r dep; do
   name="$(sed 's/^ *//; s/ *(.*//' <<<"${dep}")"
   bound="$(sed -n 's/.*(\(.*\)).*/\1/p' <<<"${dep}")"
