@@ -38,6 +38,10 @@ if [ "${ARCH}" != "${HOST_ARCH}" ] && [ -z "${SYSROOT}" ]; then
   exit 2
 fi
 
+if [ ! -f "${DEB}" ]; then
+  echo "check_deb: ${DEB}: no such file" >&2
+  exit 1
+fi
 fail=0
 bad() {
   echo "check_deb: FAIL: $*"
