@@ -32,6 +32,7 @@ DEB="$1"
 ARCH="$2"
 BUILD_DIR="$3"
 SYSROOT="${4:-}"
+if [ -n "${SYSROOT}" ]; then SYSROOT="$(cd "${SYSROOT}" && pwd)"; fi
 HOST_ARCH="$(dpkg --print-architecture)"
 if [ "${ARCH}" != "${HOST_ARCH}" ] && [ -z "${SYSROOT}" ]; then
   echo "check_deb: ${ARCH} is not the host's architecture (${HOST_ARCH}): give the SYSROOT" >&2
