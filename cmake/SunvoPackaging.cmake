@@ -17,9 +17,12 @@ set(_sunvo_programs
     sunvo_kitti_replay_cli  # sunvo_kitti_replay: paced KITTI raw playback
     sunvo_track_vo          # track-mode VO on recorded feature tracks
     sunvo_pose_reader)      # MAVLink ODOMETRY reader for the serial link
+# sunvo_packaged_programs builds just what the package installs (cpack does not build).
+add_custom_target(sunvo_packaged_programs)
 foreach(_program IN LISTS _sunvo_programs)
   if(TARGET ${_program})
     install(TARGETS ${_program} RUNTIME DESTINATION bin)
+    add_dependencies(sunvo_packaged_programs ${_program})
   endif()
 endforeach()
 

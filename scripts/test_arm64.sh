@@ -184,7 +184,7 @@ fi
 # each inspected and unpacked by scripts/check_deb.sh (architecture, files, conffiles, Depends
 # against the packages holding the linked libraries, systemd-analyze verify, udev rules).
 t0=$(stamp)
-cmake --build build/release -j"${JOBS}"
+cmake --build build/release -j"${JOBS}" --target sunvo_packaged_programs
 for pair in "aarch64 arm64" "release amd64"; do
   dir="build/${pair% *}"
   arch="${pair#* }"
