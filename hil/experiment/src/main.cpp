@@ -5,12 +5,13 @@
 //
 // Usage: sunvo_experiment [--data DIR] [--out DIR] [--routes 0020,00,06] [--frames N]
 //                         [--every N] [--seed N] [--drift-deg D] [--sun-loss S] [--paper-form]
-//                         [--write-poses] [--adaptive-drift]
+//                         [--write-poses] [--fixed-drift]
 //                         [--innovation-gate X]
-//   --drift-deg   attitude random walk of VO per frame for the sun fusion (deg)
+//   --drift-deg   attitude random walk of VO per frame for the sun fusion (deg; the start value
+//                 when it adapts)
 //   --sun-loss    Cauchy scale on the whitened sun residual (0 = none)
 //   --paper-form  hold the base attitude fixed, as the paper did
-//   --adaptive-drift  adapt the attitude random walk to the innovations (--drift-deg: start)
+//   --fixed-drift keep the attitude random walk at --drift-deg instead of adapting it
 //   --innovation-gate  chi-square bound of the innovation gate (0 = off)
 //   --write-poses also write every run's poses and the ground truth as KITTI pose files
 //                 (route_<id>_gt.txt, route_<id>_run<i>.txt; run 0 is pure VO, then the sources)
@@ -36,7 +37,7 @@ int usage(const std::string& msg) {
   std::fprintf(stderr,
                "usage: sunvo_experiment [--data DIR] [--out DIR] [--routes 0020,00,06] "
                "[--frames N] [--every N] [--seed N] [--drift-deg D] [--sun-loss S] [--paper-form] "
-               "[--write-poses] [--adaptive-drift] [--innovation-gate X]\n");
+               "[--write-poses] [--fixed-drift] [--innovation-gate X]\n");
   return 2;
 }
 
@@ -72,7 +73,7 @@ int main(int argc, char** argv) {
   double drift_deg = -1.0, sun_loss = -1.0;
   bool paper_form = false;
   bool write_poses = false;
-  bool adaptive = false;
+  bool fixed_drift = false;
   double innovation_gate = -1.0;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -98,8 +99,8 @@ int main(int argc, char** argv) {
       paper_form = true;
     } else if (a == "--write-poses") {
       write_poses = true;
-    } else if (a == "--adaptive-drift") {
-      adaptive = true;
+    } else if (a == "--fixed-drift") {
+      fixed_drift = true;
     } else if (a == "--innovation-gate" && has_value) {
       innovation_gate = std::strtod(argv[++i], nullptr);
     } else if (a == "--seed" && has_value) {
@@ -121,7 +122,7 @@ int main(int argc, char** argv) {
   if (drift_deg >= 0.0) options.fusion.attitude_drift_deg_per_frame = drift_deg;
   if (sun_loss >= 0.0) options.fusion.loss_scale = sun_loss;
   options.fusion.estimate_base_attitude = !paper_form;
-  options.fusion.adaptive_drift = adaptive;
+  if (fixed_drift) options.fusion.adaptive_drift = false;
   if (innovation_gate >= 0.0) options.fusion.innovation_gate_chi2 = innovation_gate;
   if (auto s = options.validate(); !s.isOk()) return usage(s.toString());
   const auto sources = sunvo::experiment::defaultSunSources(static_cast<std::uint32_t>(seed));

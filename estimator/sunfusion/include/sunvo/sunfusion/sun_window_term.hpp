@@ -64,12 +64,12 @@ struct SunFusionOptions {
   bool estimate_base_attitude = true;
   double initial_attitude_sigma_deg = 1.0;  // deg, (0, 45]: first pose's attitude std
   // deg, [0, 5]: random-walk std growth of the world attitude per frame (q_theta); with
-  // adaptive_drift the starting value. 0.2 gave the largest gains on the real 0020 tracks (sweep
-  // in docs/experiment.md).
-  double attitude_drift_deg_per_frame = 0.2;
-  // Adapt q_theta to the innovations (see the header comment), within [min, max] deg/frame. Off
-  // by default: it hurts less on low-drift routes but gains less where VO drifts (measured).
-  bool adaptive_drift = false;
+  // adaptive_drift the starting value.
+  double attitude_drift_deg_per_frame = 0.05;
+  // Adapt q_theta to the innovations (see the header comment), within [min, max] deg/frame. On by
+  // default: a fixed 0.2 deg/frame gains more where VO drifts fast (real 0020 tracks) but makes
+  // noisy sources far worse where VO drifts little (docs/experiment.md, ablations).
+  bool adaptive_drift = true;
   double min_drift_deg_per_frame = 0.002;  // deg/frame, [0, max]
   double max_drift_deg_per_frame = 0.5;    // deg/frame, [min, 5]
   double drift_adaptation_rate = 0.1;      // (0, 1]: log-step of q_theta per measurement
