@@ -111,6 +111,8 @@ Status LalondeOptions::validate() const {
   if (!(min_shadow_weight > 0.0 && min_shadow_weight <= 1e6)) {
     return outOfRange("min_shadow_weight", "(0, 1e6]");
   }
+  if (!inRange(along_track_deg, 0.0, 90.0)) return outOfRange("along_track_deg", "[0, 90]");
+  if (!inRange(along_track_weight, 0.0, 1.0)) return outOfRange("along_track_weight", "[0, 1]");
   if (!(max_line_weight > 0.0 && max_line_weight <= 1000.0)) {
     return outOfRange("max_line_weight", "(0, 1000]");
   }
@@ -287,7 +289,7 @@ void LalondeEstimator::skyCue(const cv::Mat& work_bgr, const cv::Mat& work_gray,
   cv::Sobel(work_gray, gradient_y_, CV_32F, 0, 1, 3, 0.25);
   cues_.sky_mask.create(h, w, CV_8U);
   cues_.sky_mask.setTo(0);
-  const double min_up = std::sin(1.0 * kDeg);
+  const double min_up = std::sin(options_.sky_min_elevation_deg * kDeg);
   const float max_grad2 = static_cast<float>(options_.sky_max_gradient * options_.sky_max_gradient);
   for (int y = 0; y < h; ++y) {
     const unsigned char* g = work_gray.ptr<unsigned char>(y);
@@ -375,10 +377,16 @@ void LalondeEstimator::skyCue(const cv::Mat& work_bgr, const cv::Mat& work_gray,
       out[c] = -rel * inv_two_sigma2;
     }
   }
-  // Relative to its best cell (only differences matter).
+  // Relative to its best cell, mixed with a uniform chance that the fit misleads:
+  // p = (1 - floor) exp(l - l_max) + floor, so a confidently wrong sky cannot veto a cell.
   double max_v = 0.0;
   cv::minMaxLoc(cues_.sky_loglik, nullptr, &max_v);
-  cv::subtract(cues_.sky_loglik, cv::Scalar(max_v), cues_.sky_loglik);
+  for (int r = 0; r < n_zen_; ++r) {
+    double* out = cues_.sky_loglik.ptr<double>(r);
+    for (int c = 0; c < n_az_; ++c) {
+      out[c] = std::log((1.0 - options_.sky_floor) * std::exp(out[c] - max_v) + options_.sky_floor);
+    }
+  }
   (void)count;
 }
 
@@ -451,7 +459,12 @@ void LalondeEstimator::shadowCue(const cv::Mat& work_bgr, const cv::Mat& work_gr
     const double len_m = std::hypot(df, dr);
     if (len_m < 0.1) continue;
     const double alpha = std::atan2(dr, df);
-    const double weight = std::min(len_m, options_.max_line_weight) * contrast;
+    // Orientation mod 180 deg: angle to the forward axis in [0, 90] deg.
+    const double to_forward = std::abs(std::remainder(alpha, kPi));
+    const double track_factor =
+        to_forward <= options_.along_track_deg * kDeg ? options_.along_track_weight : 1.0;
+    const double weight = std::min(len_m, options_.max_line_weight) * contrast * track_factor;
+    if (weight <= 0.0) continue;
     for (int c = 0; c < n_az_; ++c) {
       shadow_azimuth_[static_cast<std::size_t>(c)] +=
           weight * std::exp(kappa * (std::cos(2.0 * (azimuthOfColRad(c) - alpha)) - 1.0));

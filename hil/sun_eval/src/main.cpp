@@ -142,9 +142,12 @@ std::string fmt(double v, int digits = 1) {
 }
 
 // The VO attitude error of one frame: a rotation with each axis-angle component N(0, sigma).
-Eigen::Matrix3d priorError(unsigned long long seed, std::size_t set, std::size_t frame,
+// Seeded from the set's name (FNV-1a), so a set gets the same errors in any order.
+Eigen::Matrix3d priorError(unsigned long long seed, const std::string& set, std::size_t frame,
                            double sigma_deg) {
-  std::mt19937_64 rng(seed * 1000003ULL + set * 100003ULL + frame);
+  std::uint64_t h = 1469598103934665603ULL;
+  for (unsigned char c : set) h = (h ^ c) * 1099511628211ULL;
+  std::mt19937_64 rng(seed * 1000003ULL + h + frame);
   std::normal_distribution<double> n(0.0, sigma_deg * kDeg);
   const Eigen::Vector3d w(n(rng), n(rng), n(rng));
   if (w.norm() < 1e-15) return Eigen::Matrix3d::Identity();
@@ -273,7 +276,7 @@ int run(const Args& args) {
                      f.image_path.c_str());
         return kExitUsage;
       }
-      const Eigen::Matrix3d C_err = priorError(args.seed, si, k, args.prior_error_deg);
+      const Eigen::Matrix3d C_err = priorError(args.seed, ds.name, k, args.prior_error_deg);
       sunvo::sunfusion::ImageSunInput in;
       in.color = image;
       in.camera = ds.camera;

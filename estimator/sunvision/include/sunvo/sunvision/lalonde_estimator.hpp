@@ -55,7 +55,9 @@ struct LalondeOptions {
   double sky_saturated_gray = 250.0;  // pixels at or above are segmented but not fitted, [128, 255]
   int sky_min_pixels = 150;           // fitted pixels needed for the cue to count, [10, 100000]
   int sky_max_fit_pixels = 400;       // fitted pixels kept (uniform subsample), [50, 100000]
-  double sky_residual_sigma = 0.25;   // relative RMS fit residual worth one sigma, (0, 1]
+  double sky_residual_sigma = 0.4;    // relative RMS fit residual worth one sigma, (0, 1]
+  double sky_floor = 0.1;             // chance the sky fit misleads (haze, facades), [0.001, 1)
+  double sky_min_elevation_deg = 1.0;  // sky pixels lower than this are ignored, deg, [0, 30]
   // Shadow cue.
   double camera_height_m = 1.65;        // camera above the ground plane, m, [0.2, 20] (KITTI)
   double canny_low = 40.0;              // Canny thresholds, 8-bit units, [1, 1000]
@@ -68,6 +70,11 @@ struct LalondeOptions {
   double shadow_floor = 0.3;            // share of uniform azimuth mixed in, [0.01, 1)
   double min_shadow_weight = 2.0;       // sum of line weights (m x contrast) to count, (0, 1e6]
   double max_line_weight = 5.0;         // cap of one line's weight, m, (0, 1000]
+  // Street-aligned lines (curbs, lane markings, facade feet, roof-edge shadows) run along the
+  // camera's forward direction in city driving and would pull every estimate to 0/180 deg; a
+  // line within along_track_deg of forward counts with this factor. 1 = Lalonde's plain cue.
+  double along_track_deg = 10.0;     // deg, [0, 90]
+  double along_track_weight = 0.25;  // [0, 1]
   // Priors.
   double zenith_prior_mean_deg = 50.0;   // Lalonde prior, deg, [0, 90]
   double zenith_prior_sigma_deg = 20.0;  // deg, (0, 180]
