@@ -44,8 +44,10 @@ cv::Mat drawErrorHistogram(const std::vector<double>& values_deg, double lo_deg,
               0.4, black, 1, cv::LINE_AA);
   cv::putText(img, "0", cv::Point(30, kTop + static_cast<int>(plot_h)), cv::FONT_HERSHEY_SIMPLEX,
               0.4, black, 1, cv::LINE_AA);
-  cv::putText(img, title + "  (n = " + std::to_string(values_deg.size()) + ", error deg)",
-              cv::Point(kLeft, 24), cv::FONT_HERSHEY_SIMPLEX, 0.5, black, 1, cv::LINE_AA);
+  cv::putText(img, title + "  (n = " + std::to_string(values_deg.size()) + ")",
+              cv::Point(kLeft, 24), cv::FONT_HERSHEY_SIMPLEX, 0.45, black, 1, cv::LINE_AA);
+  cv::putText(img, "error, deg", cv::Point(kW - kRight - 70, kH - 4), cv::FONT_HERSHEY_SIMPLEX, 0.4,
+              black, 1, cv::LINE_AA);
   return img;
 }
 
