@@ -10,12 +10,14 @@
 //  - sky cue: the sky is segmented (above the horizon, bright, texture-free, bluish or neutral,
 //    connected to the image top); a Perez clear-sky luminance G(theta_p) S(gamma_p) times an
 //    unknown exposure k is fitted to the linearised sky pixels for each candidate sun, and the
-//    relative residual r = sum (L - k m)^2 / sum L^2 gives log p = -r / (2 sigma_r^2);
+//    relative residual r = sum (L - k m)^2 / sum L^2 gives log p = -r / (2 sigma_r^2), mixed
+//    with a uniform chance that the fit misleads (horizon haze, bright facades);
 //  - shadow cue: strong dark-to-bright edges on the ground (Canny + probabilistic Hough, both
 //    sides on the ground, darker side a shadow: much darker and not less blue), projected to the
 //    ground plane with the camera height and up vector. A shadow cast by a vertical object lies
 //    along the sun's azimuth, away from the sun, so each line of ground orientation alpha adds
 //    the two-peaked kernel exp(kappa (cos 2(phi - alpha) - 1)) (phi = alpha or alpha + 180 deg);
+//    lines along the camera's forward axis (curbs, markings) are down-weighted;
 //  - prior: Lalonde's zenith prior, a Gaussian over theta (from sun statistics of daytime
 //    photographs), or for Lalonde-VO a Gaussian around the sun predicted from the VO pose,
 //    sigma_az = 120 deg, sigma_zen = 30 deg (3 sigma spans 360 deg and 90 deg).
