@@ -11,21 +11,14 @@
 #include <numbers>
 #include <opencv2/core.hpp>
 
+#include "../support/synthetic_stereo.hpp"
 #include "sunvo/core/camera.hpp"
 #include "sunvo/sunvision/sky_model.hpp"
 
 namespace sunvo::sunvision::testing {
 
-inline StereoCamera kittiCamera() {
-  StereoCamera c;
-  c.fu = c.fv = 721.5377;
-  c.cu = 609.5593;
-  c.cv = 172.854;
-  c.baseline_m = 0.537;
-  c.width = 1242;
-  c.height = 375;
-  return c;
-}
+// The shared KITTI-like rectified camera of the tests (1242 x 375).
+using sunvo::testing::kittiCamera;
 
 inline unsigned char toSrgb8(double linear) {
   const double v = std::clamp(linear, 0.0, 1.0);

@@ -213,14 +213,6 @@ std::string json(const std::vector<Stats>& all, const Args& args) {
         .value(s.frames)
         .key("valid")
         .value(s.valid)
-        .key("azimuth_abs_error_median_deg")
-        .value(absPercentile(s.az_err_deg, 0.5))
-        .key("azimuth_abs_error_p90_deg")
-        .value(absPercentile(s.az_err_deg, 0.9))
-        .key("zenith_abs_error_median_deg")
-        .value(absPercentile(s.zen_err_deg, 0.5))
-        .key("zenith_abs_error_p90_deg")
-        .value(absPercentile(s.zen_err_deg, 0.9))
         .key("gross_errors")
         .value(s.gross)
         .key("gross_share")
@@ -228,15 +220,15 @@ std::string json(const std::vector<Stats>& all, const Args& args) {
         .key("kept_by_gate")
         .value(s.kept)
         .key("kept_share")
-        .value(share(s.kept, s.frames))
-        .key("time_ms_median")
-        .value(absPercentile(s.time_ms, 0.5))
-        .key("time_ms_p90")
-        .value(absPercentile(s.time_ms, 0.9))
-        .key("cpu_ms_median")
-        .value(absPercentile(s.cpu_ms, 0.5))
-        .key("cpu_ms_p90")
-        .value(absPercentile(s.cpu_ms, 0.9));
+        .value(share(s.kept, s.frames));
+    for (const auto& [name, values] : {std::pair<std::string, const std::vector<double>*>{
+                                           "azimuth_abs_error_deg", &s.az_err_deg},
+                                       {"zenith_abs_error_deg", &s.zen_err_deg},
+                                       {"time_ms", &s.time_ms},
+                                       {"cpu_ms", &s.cpu_ms}}) {
+      w.key(name + "_median").value(absPercentile(*values, 0.5));
+      w.key(name + "_p90").value(absPercentile(*values, 0.9));
+    }
     w.key("azimuth_errors_deg").beginArray();
     for (double v : s.az_err_deg) w.value(v);
     w.endArray().key("zenith_errors_deg").beginArray();
