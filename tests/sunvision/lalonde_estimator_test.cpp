@@ -126,6 +126,19 @@ TEST(Lalonde, DegenerateImagesAreInvalidNeverNaN) {
   }
 }
 
+TEST(Lalonde, CuesCanBeSwitchedOff) {
+  const StereoCamera cam = kittiCamera();
+  const cv::Mat sky_only = renderScene(cam, sunInLevelCamera(30.0, 45.0), true, false);
+  LalondeOptions o;
+  o.use_sky = false;
+  LalondeEstimator est(o);
+  ASSERT_TRUE(est.init().isOk());
+  Expected<ImageSunEstimate> e = est.estimate({sky_only, cam, SunPrior{}});
+  ASSERT_TRUE(e);
+  EXPECT_FALSE(e->valid);  // the sky was the only cue
+  EXPECT_EQ(cv::countNonZero(est.lastCues().sky_loglik != 0.0), 0);
+}
+
 TEST(Lalonde, RejectsBadInput) {
   const StereoCamera cam = kittiCamera();
   LalondeEstimator uninitialised;
@@ -137,6 +150,13 @@ TEST(Lalonde, RejectsBadInput) {
   EXPECT_FALSE(est.estimate({cv::Mat(10, 10, CV_8UC3, cv::Scalar::all(1)), cam, SunPrior{}}));
   EXPECT_FALSE(
       est.estimate({img, cam, SunPrior{Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitZ()}}));
+
+  StereoCamera bad = cam;
+  bad.fu = 0.0;
+  EXPECT_FALSE(est.estimate({img, bad, SunPrior{}}));
+  StereoCamera mono = cam;  // only the intrinsics are needed
+  mono.baseline_m = 0.0;
+  EXPECT_TRUE(est.estimate({img, mono, SunPrior{}}));
 
   LalondeEstimator vo = make(LalondePrior::kVisualOdometry);
   Expected<ImageSunEstimate> e = vo.estimate({img, cam, std::nullopt});

@@ -71,7 +71,7 @@ Status LalondeOptions::validate() const {
   }
   if (!inRange(sky_turbidity, 1.7, 10.0)) return outOfRange("sky_turbidity", "[1.7, 10]");
   if (!inRange(sky_min_gray, 0.0, 255.0)) return outOfRange("sky_min_gray", "[0, 255]");
-  if (!inRange(sky_max_gradient, 1.0, 255.0)) return outOfRange("sky_max_gradient", "[1, 255]");
+  if (!inRange(sky_max_gradient, 0.5, 255.0)) return outOfRange("sky_max_gradient", "[0.5, 255]");
   if (!inRange(sky_max_red_over_blue, 0.5, 5.0)) {
     return outOfRange("sky_max_red_over_blue", "[0.5, 5]");
   }
@@ -185,7 +185,12 @@ Expected<sunfusion::ImageSunEstimate> LalondeEstimator::estimate(
   if (input.color.empty() || (input.color.type() != CV_8UC3 && input.color.type() != CV_8UC1)) {
     return invalidArgument(std::string(name()) + ": image must be CV_8UC3 (BGR) or CV_8UC1");
   }
-  SUNVO_RETURN_IF_ERROR(input.camera.validate());
+  // Only the intrinsics matter here (a mono camera may carry no baseline).
+  const StereoCamera& cam = input.camera;
+  if (!(cam.fu > 0.0 && cam.fv > 0.0 && std::isfinite(cam.fu) && std::isfinite(cam.fv) &&
+        std::isfinite(cam.cu) && std::isfinite(cam.cv))) {
+    return invalidArgument(std::string(name()) + ": camera fu, fv must be finite and > 0 px");
+  }
   if (input.camera.width != input.color.cols || input.camera.height != input.color.rows) {
     return invalidArgument(std::string(name()) + ": image size " +
                            std::to_string(input.color.cols) + "x" +
@@ -282,11 +287,13 @@ void LalondeEstimator::skyCue(const cv::Mat& work_bgr, const cv::Mat& work_gray,
   cues_.sky_loglik.setTo(0.0);
   cues_.sky_informative = false;
   cues_.sky_pixels_fitted = 0;
+  cues_.sky_pixels_segmented = 0;
   const int w = work_gray.cols, h = work_gray.rows;
 
-  // Texture: Sobel gradient magnitude (3x3 kernel sums to 4x the per-pixel difference).
-  cv::Sobel(work_gray, gradient_x_, CV_32F, 1, 0, 3, 0.25);
-  cv::Sobel(work_gray, gradient_y_, CV_32F, 0, 1, 3, 0.25);
+  // Texture: gradient magnitude per pixel. The 3x3 Sobel response is 8x the per-pixel slope
+  // (central difference over 2 px, smoothing weights 1-2-1), hence the scale 1/8.
+  cv::Sobel(work_gray, gradient_x_, CV_32F, 1, 0, 3, 0.125);
+  cv::Sobel(work_gray, gradient_y_, CV_32F, 0, 1, 3, 0.125);
   cues_.sky_mask.create(h, w, CV_8U);
   cues_.sky_mask.setTo(0);
   const double min_up = std::sin(options_.sky_min_elevation_deg * kDeg);
@@ -315,7 +322,8 @@ void LalondeEstimator::skyCue(const cv::Mat& work_bgr, const cv::Mat& work_gray,
   for (int x = 0; x < w; ++x) {
     if (top[x] > 0) top_labels_[static_cast<std::size_t>(top[x])] = 1;
   }
-  int count = 0, fit_count = 0;
+  int fit_count = 0;
+  cues_.sky_pixels_segmented = 0;
   for (int y = 0; y < h; ++y) {
     const int* l = labels_.ptr<int>(y);
     unsigned char* m = cues_.sky_mask.ptr<unsigned char>(y);
@@ -326,7 +334,7 @@ void LalondeEstimator::skyCue(const cv::Mat& work_bgr, const cv::Mat& work_gray,
         m[x] = 0;
         continue;
       }
-      ++count;
+      ++cues_.sky_pixels_segmented;
       if (g[x] < options_.sky_saturated_gray) ++fit_count;
     }
   }
@@ -387,7 +395,6 @@ void LalondeEstimator::skyCue(const cv::Mat& work_bgr, const cv::Mat& work_gray,
       out[c] = std::log((1.0 - options_.sky_floor) * std::exp(out[c] - max_v) + options_.sky_floor);
     }
   }
-  (void)count;
 }
 
 void LalondeEstimator::shadowCue(const cv::Mat& work_bgr, const cv::Mat& work_gray, bool colour,

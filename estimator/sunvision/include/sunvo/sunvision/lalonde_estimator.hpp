@@ -50,9 +50,10 @@ struct LalondeOptions {
   // Image pyramid level the cues work on.
   int work_width_px = 640;  // px, [160, 4096]: the image is area-downscaled to this width
   // Sky cue.
-  double sky_turbidity = 2.5;      // Perez/Preetham turbidity of the fitted model, [1.7, 10]
-  double sky_min_gray = 90.0;      // 8-bit gray a sky pixel must reach, [0, 255]
-  double sky_max_gradient = 12.0;  // Sobel magnitude per px (8-bit units) above = texture, [1, 255]
+  double sky_turbidity = 2.5;  // Perez/Preetham turbidity of the fitted model, [1.7, 10]
+  double sky_min_gray = 90.0;  // 8-bit gray a sky pixel must reach, [0, 255]
+  double sky_max_gradient =
+      6.0;  // gradient magnitude per px (8-bit units) above = texture, [0.5, 255]
   double sky_max_red_over_blue = 1.1;  // R / B above = not sky (brick, sunset excluded), [0.5, 5]
   double sky_saturated_gray = 250.0;  // pixels at or above are segmented but not fitted, [128, 255]
   int sky_min_pixels = 150;           // fitted pixels needed for the cue to count, [10, 100000]
@@ -104,6 +105,7 @@ struct LalondeCues {
   cv::Mat sky_loglik, shadow_loglik, prior_loglik, posterior;  // posterior: probabilities, sum 1
   cv::Mat sky_mask;                                            // CV_8U, 255 = sky
   std::vector<ShadowLine> shadow_lines;
+  int sky_pixels_segmented = 0;  // at the work resolution
   int sky_pixels_fitted = 0;
   double shadow_weight = 0.0;
   bool sky_informative = false, shadow_informative = false;
