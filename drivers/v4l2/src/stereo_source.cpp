@@ -45,12 +45,6 @@ Status rangeError(const char* key, long long value, long long lo, long long hi) 
                          " is outside [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
 }
 
-// An error that means the device is gone or broken rather than a wrong request.
-bool isLossError(int err) {
-  return err == ENODEV || err == EIO || err == ENXIO || err == EPIPE || err == EBADF ||
-         err == ESHUTDOWN;
-}
-
 }  // namespace
 
 Status V4l2Options::validate() const {
@@ -440,12 +434,9 @@ Status V4l2StereoSource::next(StereoFrame& out) {
                                         devices_[static_cast<std::size_t>(which[0])].path};
     }
     const sysio::SysResult pr = io_.poll(fds.data(), count, msUntil(deadline, now));
-    if (!pr.ok()) {
-      if (pr.err == EINTR) continue;
-      if (isLossError(pr.err) || pr.err == EINVAL || pr.err == ENOMEM) {
-        markLost(devices_[static_cast<std::size_t>(which[0])], "poll", pr.err);
-        return deviceError("device lost: " + lost_reason_);
-      }
+    if (!pr.ok() && pr.err != EINTR) {
+      markLost(devices_[static_cast<std::size_t>(which[0])], "poll", pr.err);
+      return deviceError("device lost: " + lost_reason_);
     }
     for (nfds_t k = 0; k < count; ++k) {
       if ((fds[k].revents & (POLLERR | POLLHUP | POLLNVAL)) != 0) {

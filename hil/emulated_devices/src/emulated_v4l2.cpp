@@ -5,9 +5,9 @@
 #include <sys/mman.h>
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <cstring>
-#include <deque>
 #include <thread>
 #include <utility>
 
@@ -34,6 +34,28 @@ void copyName(std::uint8_t* dst, std::size_t size, const std::string& text) {
 std::uint8_t chromaAt(int x, int y) {
   return static_cast<std::uint8_t>((x * 7 + y * 3) & 0xff);
 }
+
+// A FIFO of buffer indices with room for every buffer: the emulated kernel's queues allocate
+// nothing per frame (a std::deque would, every 128 entries).
+class IndexFifo {
+ public:
+  bool empty() const { return size_ == 0; }
+  int front() const { return items_[head_]; }
+  void pop_front() {
+    head_ = (head_ + 1) % items_.size();
+    --size_;
+  }
+  void push_back(int index) {
+    items_[(head_ + size_) % items_.size()] = index;
+    ++size_;
+  }
+  void clear() { head_ = size_ = 0; }
+
+ private:
+  std::array<int, kMaxBuffers> items_{};
+  std::size_t head_ = 0;
+  std::size_t size_ = 0;
+};
 
 }  // namespace
 
@@ -78,8 +100,8 @@ struct EmulatedV4l2::Camera {
   v4l2_fract timeperframe{1, 30};
   std::vector<Buffer> buffers;
   std::size_t buffer_stride = 0;  // m.offset of buffer i = i * buffer_stride
-  std::deque<int> queued;
-  std::deque<int> done;
+  IndexFifo queued;               // a buffer is in at most one of them, so kMaxBuffers each suffice
+  IndexFifo done;
   int owner_fd = -1;
   bool streaming = false;
   std::uint32_t sequence = 0;
