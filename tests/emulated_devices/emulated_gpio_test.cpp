@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cerrno>
+#include <vector>
 
 namespace sunvo::emulated {
 namespace {
@@ -43,6 +44,18 @@ TEST(EmulatedGpio, FollowsLibgpiodRequestRules) {
   EXPECT_FALSE(e.rising);
   EXPECT_EQ(e.time_ns, 110);
   EXPECT_EQ(gpio.lineSetValue(in, 1), EPERM);
+
+  // A listener sees each write with its time, after the write is recorded.
+  std::vector<GpioWrite> heard;
+  ASSERT_TRUE(gpio.onOutput("gpiochip2", 0,
+                            [&](int v, TimeNs t) {
+                              heard.push_back({v, t});
+                            })
+                  .isOk());
+  ASSERT_EQ(gpio.lineSetValue(out, 1), 0);
+  ASSERT_EQ(heard.size(), 1u);
+  EXPECT_EQ(heard[0].value, 1);
+  EXPECT_EQ(heard[0].time_ns, gpio.writes("gpiochip2", 0).back().time_ns);
 
   EXPECT_EQ(gpio.openChips(), 1);
   gpio.chipClose(chip);  // releases both lines

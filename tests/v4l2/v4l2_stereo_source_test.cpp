@@ -266,6 +266,22 @@ TEST(V4l2StereoSource, FlaggedBufferIsRequeuedSkippedAndCounted) {
   }
 }
 
+TEST(V4l2StereoSource, ShortBufferIsRequeuedSkippedAndCounted) {
+  Rig rig(V4l2Layout::kTwoDevices);
+  auto source = openOrFail(fastOptions(V4l2Layout::kTwoDevices, V4l2PixelFormat::kYuyv), rig.emu);
+  ASSERT_NE(source, nullptr);
+  ASSERT_TRUE(rig.emu.injectShortFrames(kRight, 1).isOk());
+  rig.emu.trigger(kT0);
+  rig.emu.trigger(kT0 + kPeriod);
+  StereoFrame frame;
+  ASSERT_TRUE(source->next(frame).isOk());
+  EXPECT_EQ(frame.trigger_time_ns, kT0 + kPeriod);
+  EXPECT_TRUE(sameImage(frame.right, rig.right(1)));
+  EXPECT_EQ(source->counters().short_buffers, 1u);
+  EXPECT_EQ(source->counters().buffer_errors, 0u);
+  EXPECT_EQ(source->counters().pairing_drops, 1u);  // the left buffer of exposure 0
+}
+
 TEST(V4l2StereoSource, FrameDroppedOnOneEyeIsDroppedFromTheOtherAndCounted) {
   Rig rig(V4l2Layout::kTwoDevices);
   auto source = openOrFail(fastOptions(V4l2Layout::kTwoDevices, V4l2PixelFormat::kGrey), rig.emu);

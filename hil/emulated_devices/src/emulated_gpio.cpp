@@ -27,6 +27,7 @@ struct EmulatedGpio::Line {
   int duplicate_strobes = 0;
   TimeNs duplicate_gap_ns = 0;
   int fail_err = 0;
+  OutputListener listener;
 };
 
 struct EmulatedGpio::Chip {
@@ -71,70 +72,60 @@ int EmulatedGpio::takeFault(Line& l) {
   return err;
 }
 
-Status EmulatedGpio::pushEdge(const std::string& chip, int line, TimeNs time_ns, bool rising) {
+Status EmulatedGpio::withLine(const std::string& chip, int line,
+                              const std::function<void(Line&)>& change) {
   {
     std::lock_guard lock(mutex_);
     Line* l = findLine(chip, line);
-    if (l == nullptr)
+    if (l == nullptr) {
       return invalidArgument("no emulated gpio " + chip + " line " + std::to_string(line));
-    if (l->mode == Line::Mode::kEvents) l->events.push_back({time_ns, rising});
+    }
+    change(*l);
   }
   changed_.notify_all();
   return Status::ok();
+}
+
+Status EmulatedGpio::pushEdge(const std::string& chip, int line, TimeNs time_ns, bool rising) {
+  return withLine(chip, line, [&](Line& l) {
+    if (l.mode == Line::Mode::kEvents) l.events.push_back({time_ns, rising});
+  });
 }
 
 Status EmulatedGpio::strobe(const std::string& chip, int line, TimeNs time_ns, TimeNs width_ns) {
-  {
-    std::lock_guard lock(mutex_);
-    Line* l = findLine(chip, line);
-    if (l == nullptr)
-      return invalidArgument("no emulated gpio " + chip + " line " + std::to_string(line));
-    if (l->drop_strobes > 0) {
-      --l->drop_strobes;
-      return Status::ok();
+  return withLine(chip, line, [&](Line& l) {
+    if (l.drop_strobes > 0) {
+      --l.drop_strobes;
+      return;
     }
-    if (l->mode != Line::Mode::kEvents) return Status::ok();
-    l->events.push_back({time_ns, true});
-    l->events.push_back({time_ns + width_ns, false});
-    if (l->duplicate_strobes > 0) {
-      --l->duplicate_strobes;
-      l->events.push_back({time_ns + l->duplicate_gap_ns, true});
-      l->events.push_back({time_ns + l->duplicate_gap_ns + width_ns, false});
+    if (l.mode != Line::Mode::kEvents) return;
+    l.events.push_back({time_ns, true});
+    l.events.push_back({time_ns + width_ns, false});
+    if (l.duplicate_strobes > 0) {
+      --l.duplicate_strobes;
+      l.events.push_back({time_ns + l.duplicate_gap_ns, true});
+      l.events.push_back({time_ns + l.duplicate_gap_ns + width_ns, false});
     }
-  }
-  changed_.notify_all();
-  return Status::ok();
+  });
 }
 
 Status EmulatedGpio::dropStrobes(const std::string& chip, int line, int count) {
-  std::lock_guard lock(mutex_);
-  Line* l = findLine(chip, line);
-  if (l == nullptr)
-    return invalidArgument("no emulated gpio " + chip + " line " + std::to_string(line));
-  l->drop_strobes += count;
-  return Status::ok();
+  return withLine(chip, line, [&](Line& l) { l.drop_strobes += count; });
 }
 
 Status EmulatedGpio::duplicateStrobes(const std::string& chip, int line, int count, TimeNs gap_ns) {
-  std::lock_guard lock(mutex_);
-  Line* l = findLine(chip, line);
-  if (l == nullptr)
-    return invalidArgument("no emulated gpio " + chip + " line " + std::to_string(line));
-  l->duplicate_strobes += count;
-  l->duplicate_gap_ns = gap_ns;
-  return Status::ok();
+  return withLine(chip, line, [&](Line& l) {
+    l.duplicate_strobes += count;
+    l.duplicate_gap_ns = gap_ns;
+  });
 }
 
 Status EmulatedGpio::failNextCall(const std::string& chip, int line, int err) {
-  {
-    std::lock_guard lock(mutex_);
-    Line* l = findLine(chip, line);
-    if (l == nullptr)
-      return invalidArgument("no emulated gpio " + chip + " line " + std::to_string(line));
-    l->fail_err = err;
-  }
-  changed_.notify_all();
-  return Status::ok();
+  return withLine(chip, line, [&](Line& l) { l.fail_err = err; });
+}
+
+Status EmulatedGpio::onOutput(const std::string& chip, int line, OutputListener listener) {
+  return withLine(chip, line, [&](Line& l) { l.listener = std::move(listener); });
 }
 
 std::vector<GpioWrite> EmulatedGpio::writes(const std::string& chip, int line) const {
@@ -223,12 +214,19 @@ int EmulatedGpio::lineRequestBothEdgesEvents(gpio::LineHandle line, const char* 
 }
 
 int EmulatedGpio::lineSetValue(gpio::LineHandle line, int value) {
-  std::lock_guard lock(mutex_);
-  auto& l = *static_cast<Line*>(line.impl);
-  if (const int err = takeFault(l); err != 0) return err;
-  if (l.mode != Line::Mode::kOutput) return EPERM;
-  l.value = value != 0 ? 1 : 0;
-  l.writes.push_back({l.value, steadyNowNs()});
+  OutputListener listener;
+  GpioWrite write;
+  {
+    std::lock_guard lock(mutex_);
+    auto& l = *static_cast<Line*>(line.impl);
+    if (const int err = takeFault(l); err != 0) return err;
+    if (l.mode != Line::Mode::kOutput) return EPERM;
+    l.value = value != 0 ? 1 : 0;
+    write = {l.value, steadyNowNs()};
+    l.writes.push_back(write);
+    listener = l.listener;
+  }
+  if (listener) listener(write.value, write.time_ns);
   return 0;
 }
 

@@ -106,6 +106,7 @@ struct EmulatedV4l2::Camera {
   bool streaming = false;
   std::uint32_t sequence = 0;
   int error_frames = 0;
+  int short_frames = 0;
   int drop_frames = 0;
   std::vector<TimeNs> open_attempts;
   cv::Mat gray;
@@ -181,42 +182,41 @@ int EmulatedV4l2::fileError(const OpenFile* f) const {
   return 0;
 }
 
-Status EmulatedV4l2::injectBufferErrors(const std::string& path, int frames) {
-  std::lock_guard lock(mutex_);
-  Camera* c = find(path);
-  if (c == nullptr) return invalidArgument("no emulated camera " + path);
-  c->error_frames += frames;
-  return Status::ok();
-}
-
-Status EmulatedV4l2::dropFrames(const std::string& path, int frames) {
-  std::lock_guard lock(mutex_);
-  Camera* c = find(path);
-  if (c == nullptr) return invalidArgument("no emulated camera " + path);
-  c->drop_frames += frames;
-  return Status::ok();
-}
-
-Status EmulatedV4l2::unplug(const std::string& path, std::chrono::milliseconds duration) {
+Status EmulatedV4l2::withCamera(const std::string& path,
+                                const std::function<void(Camera&)>& change) {
   {
     std::lock_guard lock(mutex_);
     Camera* c = find(path);
     if (c == nullptr) return invalidArgument("no emulated camera " + path);
-    c->replug_at_ns =
-        steadyNowNs() + std::chrono::duration_cast<std::chrono::nanoseconds>(duration).count();
-    ++c->generation;  // every fd opened before is dead for good
-    resetQueue(*c);
+    change(*c);
   }
   changed_.notify_all();
   return Status::ok();
 }
 
+Status EmulatedV4l2::injectBufferErrors(const std::string& path, int frames) {
+  return withCamera(path, [&](Camera& c) { c.error_frames += frames; });
+}
+
+Status EmulatedV4l2::injectShortFrames(const std::string& path, int frames) {
+  return withCamera(path, [&](Camera& c) { c.short_frames += frames; });
+}
+
+Status EmulatedV4l2::dropFrames(const std::string& path, int frames) {
+  return withCamera(path, [&](Camera& c) { c.drop_frames += frames; });
+}
+
+Status EmulatedV4l2::unplug(const std::string& path, std::chrono::milliseconds duration) {
+  return withCamera(path, [&](Camera& c) {
+    c.replug_at_ns =
+        steadyNowNs() + std::chrono::duration_cast<std::chrono::nanoseconds>(duration).count();
+    ++c.generation;  // every fd opened before is dead for good
+    resetQueue(c);
+  });
+}
+
 Status EmulatedV4l2::setTimestampOffset(const std::string& path, TimeNs offset_ns) {
-  std::lock_guard lock(mutex_);
-  Camera* c = find(path);
-  if (c == nullptr) return invalidArgument("no emulated camera " + path);
-  c->config.timestamp_offset_ns = offset_ns;
-  return Status::ok();
+  return withCamera(path, [&](Camera& c) { c.config.timestamp_offset_ns = offset_ns; });
 }
 
 EmulatedV4l2Stats EmulatedV4l2::stats() const {
@@ -303,6 +303,10 @@ void EmulatedV4l2::capture(Camera& c, TimeNs time_ns, std::uint64_t frame) {
     b.flags = V4L2_BUF_FLAG_ERROR;
   }
   b.bytesused = c.sizeimage;
+  if (c.short_frames > 0) {
+    --c.short_frames;
+    b.bytesused = c.sizeimage / 2;  // a transfer cut short
+  }
   b.sequence = c.sequence++;
   b.time_ns = time_ns + c.config.timestamp_offset_ns;
   b.state = Camera::Buffer::State::kDone;

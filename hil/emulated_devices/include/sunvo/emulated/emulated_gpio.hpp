@@ -13,6 +13,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -50,6 +51,12 @@ class EmulatedGpio final : public gpio::GpioApi {
   Status duplicateStrobes(const std::string& chip, int line, int count, TimeNs gap_ns);
   Status failNextCall(const std::string& chip, int line, int err);
 
+  // Called after every value written to an output line (value, steady-clock time of the write),
+  // outside the lock: wires a trigger output to emulated cameras, e.g.
+  // [&](int v, TimeNs t) { if (v == 1) cameras.trigger(t + exposure_delay); }.
+  using OutputListener = std::function<void(int value, TimeNs time_ns)>;
+  Status onOutput(const std::string& chip, int line, OutputListener listener);
+
   // Introspection (an unknown chip or line reads as empty, 0 or false).
   std::vector<GpioWrite> writes(const std::string& chip, int line) const;
   int value(const std::string& chip, int line) const;
@@ -72,6 +79,8 @@ class EmulatedGpio final : public gpio::GpioApi {
   struct Chip;
 
   Line* findLine(const std::string& chip, int line) const;
+  // Runs change on the named line under the lock, then wakes waiters.
+  Status withLine(const std::string& chip, int line, const std::function<void(Line&)>& change);
   int takeFault(Line& l);
 
   mutable std::mutex mutex_;

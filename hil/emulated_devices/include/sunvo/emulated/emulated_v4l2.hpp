@@ -18,7 +18,8 @@
 // it from its content generator (GREY, or YUYV with a non-constant chroma that a converter must
 // ignore), stamps it time + timestamp_offset_ns, and numbers it with a per-stream sequence that
 // also counts frames lost for want of a queued buffer. No trigger = no frame (a stall).
-// Faults: flagged buffers (V4L2_BUF_FLAG_ERROR), frames dropped on one camera, unplug for a time
+// Faults: flagged buffers (V4L2_BUF_FLAG_ERROR), short buffers (bytesused half the image), frames
+// dropped on one camera, unplug for a time
 // (open fails ENOENT, open fds fail ENODEV / poll POLLERR|POLLHUP; afterwards open works again).
 // Thread-safe: a test thread may trigger while the driver polls.
 
@@ -86,6 +87,7 @@ class EmulatedV4l2 final : public sysio::SysIo {
 
   // Faults, each on the named camera (kInvalidArgument for an unknown path):
   Status injectBufferErrors(const std::string& path, int frames);  // next frames flagged ERROR
+  Status injectShortFrames(const std::string& path, int frames);   // next frames half as long
   Status dropFrames(const std::string& path, int frames);          // next frames never delivered
   Status unplug(const std::string& path, std::chrono::milliseconds duration);  // gone, then back
   Status setTimestampOffset(const std::string& path, TimeNs offset_ns);
@@ -113,6 +115,8 @@ class EmulatedV4l2 final : public sysio::SysIo {
   struct Mapping;
 
   Camera* find(const std::string& path) const;
+  // Runs change on the named camera under the lock, then wakes waiters.
+  Status withCamera(const std::string& path, const std::function<void(Camera&)>& change);
   bool present(const Camera& c) const;
   void resetQueue(Camera& c);
   int fileError(const OpenFile* f) const;
