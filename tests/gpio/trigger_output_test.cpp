@@ -9,18 +9,13 @@
 
 #include "sunvo/emulated/emulated_gpio.hpp"
 #include "sunvo/gpio/trigger.hpp"
+#include "sunvo/sysio/sysio.hpp"
 
 namespace sunvo::gpio {
 namespace {
 
 const std::string kChip = "gpiochip0";
 constexpr int kLine = 5;
-
-TimeNs nowNs() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::steady_clock::now().time_since_epoch())
-      .count();
-}
 
 TriggerOutputOptions options(double rate_hz = 10.0, int width_us = 2000) {
   TriggerOutputOptions o;
@@ -134,10 +129,10 @@ TEST_F(TriggerOutputTest, PulseTrainFollowsTheScheduleInRealTime) {
   TriggerOutput& out = **opened;
   const std::size_t before = gpio_.writes(kChip, kLine).size();
   for (int i = 0; i < 20; ++i) {
-    const TimeNs due = out.nextPulseTime(nowNs());
-    const TimeNs wait = due - nowNs();
+    const TimeNs due = out.nextPulseTime(sysio::monotonicNowNs());
+    const TimeNs wait = due - sysio::monotonicNowNs();
     if (wait > 0) std::this_thread::sleep_for(std::chrono::nanoseconds(wait));
-    ASSERT_TRUE(out.pulse(nowNs()).isOk());
+    ASSERT_TRUE(out.pulse(sysio::monotonicNowNs()).isOk());
   }
   const auto writes = gpio_.writes(kChip, kLine);
   ASSERT_EQ(writes.size(), before + 40);

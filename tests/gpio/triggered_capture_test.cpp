@@ -12,18 +12,13 @@
 #include "sunvo/emulated/emulated_v4l2.hpp"
 #include "sunvo/gpio/trigger.hpp"
 #include "sunvo/gpio/trigger_pairer.hpp"
+#include "sunvo/sysio/sysio.hpp"
 #include "sunvo/v4l2/stereo_source.hpp"
 
 namespace sunvo {
 namespace {
 
 constexpr TimeNs kExposureDelay = 3'000'000;  // trigger edge → driver timestamp, ns
-
-TimeNs nowNs() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::steady_clock::now().time_since_epoch())
-      .count();
-}
 
 TEST(TriggeredCapture, EveryFrameIsMatchedToThePulseThatExposedIt) {
   emulated::EmulatedGpio gpio;
@@ -69,9 +64,10 @@ TEST(TriggeredCapture, EveryFrameIsMatchedToThePulseThatExposedIt) {
     if (k == 12) {
       ASSERT_TRUE(cameras.dropFrames("/dev/video0", 1).isOk());
     }
-    const TimeNs due = (*trigger)->nextPulseTime(nowNs());
-    if (due > nowNs()) std::this_thread::sleep_for(std::chrono::nanoseconds(due - nowNs()));
-    ASSERT_TRUE((*trigger)->pulse(nowNs()).isOk());
+    const TimeNs due = (*trigger)->nextPulseTime(sysio::monotonicNowNs());
+    if (due > sysio::monotonicNowNs())
+      std::this_thread::sleep_for(std::chrono::nanoseconds(due - sysio::monotonicNowNs()));
+    ASSERT_TRUE((*trigger)->pulse(sysio::monotonicNowNs()).isOk());
     pulses.push_back((*trigger)->lastPulse());
     pairer->addTrigger((*trigger)->lastPulse());
     StereoFrame frame;

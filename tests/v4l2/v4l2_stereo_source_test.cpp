@@ -14,6 +14,7 @@
 
 #if defined(SUNVO_HAVE_ALLOC_COUNTER)
 #include "sunvo/bench/alloc_counter.hpp"
+#include "sunvo/sysio/sysio.hpp"
 #endif
 
 namespace sunvo::v4l2 {
@@ -28,12 +29,6 @@ constexpr TimeNs kPeriod = 100'000'000;            // 10 Hz
 constexpr TimeNs kT0 = 1'700'000'000'000'000'000;  // a trigger time, ns (whole microseconds)
 const std::string kLeft = "/dev/video0";
 const std::string kRight = "/dev/video1";
-
-TimeNs nowNs() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::steady_clock::now().time_since_epoch())
-      .count();
-}
 
 std::vector<cv::Mat> randomImages(int n, int w, int h, int seed) {
   cv::RNG rng(static_cast<std::uint64_t>(seed));
@@ -332,9 +327,9 @@ TEST(V4l2StereoSource, StallTimesOutWithinTheWatchdogAndResetsAfterRepeats) {
   StereoFrame frame;
   for (int i = 0; i < 3; ++i) {
     const std::uint64_t waited_before = rig.emu.stats().waited_ms;
-    const TimeNs start = nowNs();
+    const TimeNs start = sysio::monotonicNowNs();
     const Status s = source->next(frame);
-    const TimeNs took = nowNs() - start;
+    const TimeNs took = sysio::monotonicNowNs() - start;
     EXPECT_EQ(s.code(), StatusCode::kTimeout);
     EXPECT_NE(s.message().find(kLeft), std::string::npos) << s.message();
     // The driver asked the kernel to block for the dequeue timeout and no longer (each wait
@@ -376,7 +371,7 @@ TEST(V4l2StereoSource, UnpluggedDeviceIsReopenedWithBoundedExponentialBackoff) {
   const std::uint64_t sequence_before = frame.sequence;
 
   constexpr int kOutageMs = 500;
-  const TimeNs unplugged_at = nowNs();
+  const TimeNs unplugged_at = sysio::monotonicNowNs();
   ASSERT_TRUE(rig.emu.unplug(kLeft, std::chrono::milliseconds(kOutageMs)).isOk());
   const TimeNs back_at = unplugged_at + kOutageMs * 1'000'000LL;
 
@@ -384,17 +379,17 @@ TEST(V4l2StereoSource, UnpluggedDeviceIsReopenedWithBoundedExponentialBackoff) {
   std::uint64_t longest_wait_ms = 0;
   TimeNs loss_seen_at = 0;
   TimeNs first_frame_at = 0;
-  while (nowNs() < unplugged_at + 5'000'000'000LL) {
+  while (sysio::monotonicNowNs() < unplugged_at + 5'000'000'000LL) {
     rig.emu.trigger(t);
     t += kPeriod;
     const std::uint64_t waited_before = rig.emu.stats().waited_ms;
     const Status s = source->next(frame);
     longest_wait_ms = std::max(longest_wait_ms, rig.emu.stats().waited_ms - waited_before);
     if (s.isOk()) {
-      first_frame_at = nowNs();
+      first_frame_at = sysio::monotonicNowNs();
       break;
     }
-    if (errors++ == 0) loss_seen_at = nowNs();
+    if (errors++ == 0) loss_seen_at = sysio::monotonicNowNs();
     // kDeviceError while the device is gone; kTimeout right after the reopen, since the exposure
     // of this iteration came before the stream was back.
     EXPECT_TRUE(s.code() == StatusCode::kDeviceError || s.code() == StatusCode::kTimeout)

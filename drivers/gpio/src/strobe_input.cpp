@@ -1,18 +1,8 @@
-#include <chrono>
-
 #include "requested_line.hpp"
 #include "sunvo/gpio/trigger.hpp"
+#include "sunvo/sysio/sysio.hpp"
 
 namespace sunvo::gpio {
-namespace {
-
-TimeNs steadyNowNs() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::steady_clock::now().time_since_epoch())
-      .count();
-}
-
-}  // namespace
 
 Status StrobeInputOptions::validate() const {
   SUNVO_RETURN_IF_ERROR(gpio.validate("strobe_input"));
@@ -40,9 +30,10 @@ StrobeInput::~StrobeInput() {
 }
 
 Expected<TriggerEvent> StrobeInput::next() {
-  const TimeNs deadline = steadyNowNs() + static_cast<TimeNs>(options_.wait_timeout_ms) * 1'000'000;
+  const TimeNs deadline =
+      sysio::monotonicNowNs() + static_cast<TimeNs>(options_.wait_timeout_ms) * 1'000'000;
   for (;;) {
-    const TimeNs left = deadline - steadyNowNs();
+    const TimeNs left = deadline - sysio::monotonicNowNs();
     bool ready = false;
     if (left > 0) {
       const int err = api_.lineEventWait(line_, left, ready);

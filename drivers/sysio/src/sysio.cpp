@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <ctime>
 
 namespace sunvo::sysio {
 namespace {
@@ -43,6 +44,12 @@ class LinuxSysIo final : public SysIo {
 SysIo& linuxSysIo() {
   static LinuxSysIo io;
   return io;
+}
+
+std::int64_t monotonicNowNs() {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
 }
 
 SysResult ioctlRetry(SysIo& io, int fd, unsigned long request, void* arg) {

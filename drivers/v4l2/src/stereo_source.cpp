@@ -5,19 +5,12 @@
 
 #include <algorithm>
 #include <cerrno>
-#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <utility>
 
 namespace sunvo::v4l2 {
 namespace {
-
-TimeNs steadyNowNs() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::steady_clock::now().time_since_epoch())
-      .count();
-}
 
 // Milliseconds from now to deadline, rounded up so that a wait never ends before the deadline.
 int msUntil(TimeNs deadline_ns, TimeNs now_ns) {
@@ -38,6 +31,15 @@ std::string fourcc(std::uint32_t f) {
   for (int i = 0; i < 4; ++i)
     s[static_cast<std::size_t>(i)] = static_cast<char>((f >> (8 * i)) & 0xff);
   return s;
+}
+
+// The v4l2_buffer of a capture MMAP buffer, as QUERYBUF, QBUF and DQBUF take it.
+v4l2_buffer mmapBuffer(std::uint32_t index) {
+  v4l2_buffer buf{};
+  buf.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+  buf.memory = V4L2_MEMORY_MMAP;
+  buf.index = index;
+  return buf;
 }
 
 Status rangeError(const char* key, long long value, long long lo, long long hi) {
@@ -185,10 +187,7 @@ Status V4l2StereoSource::openDevice(Device& d) {
   d.buffer_count = static_cast<int>(req.count);
 
   for (int i = 0; i < d.buffer_count; ++i) {
-    v4l2_buffer buf{};
-    buf.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-    buf.memory = V4L2_MEMORY_MMAP;
-    buf.index = static_cast<std::uint32_t>(i);
+    v4l2_buffer buf = mmapBuffer(static_cast<std::uint32_t>(i));
     r = sysio::ioctlRetry(io_, d.fd, VIDIOC_QUERYBUF, &buf);
     if (!r.ok()) return fail("VIDIOC_QUERYBUF", r.err);
     if (buf.length < d.size_image) {
@@ -203,10 +202,7 @@ Status V4l2StereoSource::openDevice(Device& d) {
     d.buffers[static_cast<std::size_t>(i)] = {m.addr, buf.length};
   }
   for (int i = 0; i < d.buffer_count; ++i) {
-    v4l2_buffer buf{};
-    buf.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-    buf.memory = V4L2_MEMORY_MMAP;
-    buf.index = static_cast<std::uint32_t>(i);
+    v4l2_buffer buf = mmapBuffer(static_cast<std::uint32_t>(i));
     r = sysio::ioctlRetry(io_, d.fd, VIDIOC_QBUF, &buf);
     if (!r.ok()) return fail("VIDIOC_QBUF", r.err);
   }
@@ -259,15 +255,12 @@ void V4l2StereoSource::markLost(const Device& d, const char* what, int err) {
   lost_ = true;
   ++counters_.device_losses;
   backoff_ms_ = options_.reopen_backoff_initial_ms;
-  next_reopen_ns_ = steadyNowNs() + static_cast<TimeNs>(backoff_ms_) * 1'000'000;
+  next_reopen_ns_ = sysio::monotonicNowNs() + static_cast<TimeNs>(backoff_ms_) * 1'000'000;
   sequence_base_ = next_sequence_;
 }
 
 bool V4l2StereoSource::requeue(Device& d, Held& held) {
-  v4l2_buffer buf{};
-  buf.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-  buf.memory = V4L2_MEMORY_MMAP;
-  buf.index = held.index;
+  v4l2_buffer buf = mmapBuffer(held.index);
   held.valid = false;
   const sysio::SysResult r = sysio::ioctlRetry(io_, d.fd, VIDIOC_QBUF, &buf);
   if (!r.ok()) {
@@ -279,9 +272,7 @@ bool V4l2StereoSource::requeue(Device& d, Held& held) {
 
 V4l2StereoSource::Take V4l2StereoSource::takeBuffer(Device& d) {
   for (;;) {
-    v4l2_buffer buf{};
-    buf.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-    buf.memory = V4L2_MEMORY_MMAP;
+    v4l2_buffer buf = mmapBuffer(0);
     const sysio::SysResult r = sysio::ioctlRetry(io_, d.fd, VIDIOC_DQBUF, &buf);
     if (r.err == EAGAIN) return Take::kNone;
     if (!r.ok()) {
@@ -352,7 +343,7 @@ Status V4l2StereoSource::deliver(StereoFrame& out) {
 
 Status V4l2StereoSource::waitForReopen(TimeNs deadline) {
   for (;;) {
-    const TimeNs now = steadyNowNs();
+    const TimeNs now = sysio::monotonicNowNs();
     if (now >= next_reopen_ns_) {
       Status s = openAll();
       if (s.isOk()) {
@@ -364,15 +355,15 @@ Status V4l2StereoSource::waitForReopen(TimeNs deadline) {
       ++counters_.reopen_failures;
       backoff_ms_ = std::min(2 * backoff_ms_, options_.reopen_backoff_max_ms);
       // The wait counts from the end of the failed attempt.
-      next_reopen_ns_ = steadyNowNs() + static_cast<TimeNs>(backoff_ms_) * 1'000'000;
+      next_reopen_ns_ = sysio::monotonicNowNs() + static_cast<TimeNs>(backoff_ms_) * 1'000'000;
       lost_reason_ = s.message();
     }
     // Sleep until the next attempt; if that is after the deadline, sleep until the deadline only.
-    const TimeNs t = steadyNowNs();
+    const TimeNs t = sysio::monotonicNowNs();
     if (next_reopen_ns_ > deadline) {
       if (deadline > t) (void)io_.poll(nullptr, 0, msUntil(deadline, t));
       return deviceError("device lost, reopening in " +
-                         std::to_string(msUntil(next_reopen_ns_, steadyNowNs())) +
+                         std::to_string(msUntil(next_reopen_ns_, sysio::monotonicNowNs())) +
                          " ms: " + lost_reason_);
     }
     if (next_reopen_ns_ > t) (void)io_.poll(nullptr, 0, msUntil(next_reopen_ns_, t));
@@ -381,7 +372,7 @@ Status V4l2StereoSource::waitForReopen(TimeNs deadline) {
 
 Status V4l2StereoSource::next(StereoFrame& out) {
   const TimeNs deadline =
-      steadyNowNs() + static_cast<TimeNs>(options_.dequeue_timeout_ms) * 1'000'000;
+      sysio::monotonicNowNs() + static_cast<TimeNs>(options_.dequeue_timeout_ms) * 1'000'000;
   if (lost_) SUNVO_RETURN_IF_ERROR(waitForReopen(deadline));
 
   const int n = deviceCount();
@@ -418,7 +409,7 @@ Status V4l2StereoSource::next(StereoFrame& out) {
       which[count] = i;
       ++count;
     }
-    const TimeNs now = steadyNowNs();
+    const TimeNs now = sysio::monotonicNowNs();
     if (now >= deadline) {
       ++counters_.timeouts;
       ++consecutive_timeouts_;

@@ -3,16 +3,10 @@
 #include <cerrno>
 #include <chrono>
 
+#include "sunvo/sysio/sysio.hpp"
+
 namespace sunvo::emulated {
-namespace {
-
-TimeNs steadyNowNs() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::steady_clock::now().time_since_epoch())
-      .count();
-}
-
-}  // namespace
+namespace {}  // namespace
 
 struct EmulatedGpio::Line {
   enum class Mode { kFree, kOutput, kEvents };
@@ -189,28 +183,31 @@ int EmulatedGpio::chipGetLine(gpio::ChipHandle chip, unsigned offset, gpio::Line
   return 0;
 }
 
-int EmulatedGpio::lineRequestOutput(gpio::LineHandle line, const char* consumer,
-                                    int default_value) {
+int EmulatedGpio::request(gpio::LineHandle line, const char* consumer, bool output,
+                          int default_value) {
   std::lock_guard lock(mutex_);
   auto& l = *static_cast<Line*>(line.impl);
   if (const int err = takeFault(l); err != 0) return err;
   if (l.mode != Line::Mode::kFree) return EBUSY;
-  l.mode = Line::Mode::kOutput;
   l.consumer = consumer;
-  l.value = default_value != 0 ? 1 : 0;
-  l.writes.push_back({l.value, steadyNowNs()});
+  if (output) {
+    l.mode = Line::Mode::kOutput;
+    l.value = default_value != 0 ? 1 : 0;
+    l.writes.push_back({l.value, sysio::monotonicNowNs()});
+  } else {
+    l.mode = Line::Mode::kEvents;
+    l.events.clear();
+  }
   return 0;
 }
 
+int EmulatedGpio::lineRequestOutput(gpio::LineHandle line, const char* consumer,
+                                    int default_value) {
+  return request(line, consumer, true, default_value);
+}
+
 int EmulatedGpio::lineRequestBothEdgesEvents(gpio::LineHandle line, const char* consumer) {
-  std::lock_guard lock(mutex_);
-  auto& l = *static_cast<Line*>(line.impl);
-  if (const int err = takeFault(l); err != 0) return err;
-  if (l.mode != Line::Mode::kFree) return EBUSY;
-  l.mode = Line::Mode::kEvents;
-  l.consumer = consumer;
-  l.events.clear();
-  return 0;
+  return request(line, consumer, false, 0);
 }
 
 int EmulatedGpio::lineSetValue(gpio::LineHandle line, int value) {
@@ -222,7 +219,7 @@ int EmulatedGpio::lineSetValue(gpio::LineHandle line, int value) {
     if (const int err = takeFault(l); err != 0) return err;
     if (l.mode != Line::Mode::kOutput) return EPERM;
     l.value = value != 0 ? 1 : 0;
-    write = {l.value, steadyNowNs()};
+    write = {l.value, sysio::monotonicNowNs()};
     l.writes.push_back(write);
     listener = l.listener;
   }

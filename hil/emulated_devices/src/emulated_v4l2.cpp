@@ -18,12 +18,6 @@ constexpr std::uint32_t kMinBuffers = 2;
 constexpr std::uint32_t kMaxBuffers = 32;
 constexpr std::size_t kPage = 4096;
 
-TimeNs steadyNowNs() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::steady_clock::now().time_since_epoch())
-      .count();
-}
-
 void copyName(std::uint8_t* dst, std::size_t size, const std::string& text) {
   std::memset(dst, 0, size);
   std::memcpy(dst, text.data(), std::min(size - 1, text.size()));
@@ -92,7 +86,7 @@ struct EmulatedV4l2::Camera {
   };
 
   EmulatedCameraConfig config;
-  TimeNs replug_at_ns = 0;  // steady clock; the camera is present from then on
+  TimeNs replug_at_ns = 0;  // monotonic clock; the camera is present from then on
   std::uint64_t generation = 0;
   std::uint32_t pixelformat = 0;
   std::uint32_t bytesperline = 0;
@@ -165,7 +159,7 @@ EmulatedV4l2::Camera* EmulatedV4l2::find(const std::string& path) const {
 }
 
 bool EmulatedV4l2::present(const Camera& c) const {
-  return steadyNowNs() >= c.replug_at_ns;
+  return sysio::monotonicNowNs() >= c.replug_at_ns;
 }
 
 void EmulatedV4l2::resetQueue(Camera& c) {
@@ -208,8 +202,8 @@ Status EmulatedV4l2::dropFrames(const std::string& path, int frames) {
 
 Status EmulatedV4l2::unplug(const std::string& path, std::chrono::milliseconds duration) {
   return withCamera(path, [&](Camera& c) {
-    c.replug_at_ns =
-        steadyNowNs() + std::chrono::duration_cast<std::chrono::nanoseconds>(duration).count();
+    c.replug_at_ns = sysio::monotonicNowNs() +
+                     std::chrono::duration_cast<std::chrono::nanoseconds>(duration).count();
     ++c.generation;  // every fd opened before is dead for good
     resetQueue(c);
   });
@@ -317,7 +311,7 @@ void EmulatedV4l2::capture(Camera& c, TimeNs time_ns, std::uint64_t frame) {
 sysio::SysResult EmulatedV4l2::open(const char* path, int flags) {
   std::lock_guard lock(mutex_);
   Camera* c = find(path);
-  if (c != nullptr) c->open_attempts.push_back(steadyNowNs());
+  if (c != nullptr) c->open_attempts.push_back(sysio::monotonicNowNs());
   if (c == nullptr || !present(*c)) {
     ++stats_.failed_opens;
     return {-1, ENOENT};

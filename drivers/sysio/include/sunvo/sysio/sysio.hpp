@@ -14,6 +14,7 @@
 #include <sys/types.h>
 
 #include <cstddef>
+#include <cstdint>
 
 namespace sunvo::sysio {
 
@@ -53,6 +54,10 @@ class SysIo {
 
 // The process-wide forwarder to the real syscalls.
 SysIo& linuxSysIo();
+
+// CLOCK_MONOTONIC in ns: the clock of the drivers' deadlines, and the one the kernel stamps V4L2
+// buffers (V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC) and GPIO line events (Linux >= 5.7) with.
+std::int64_t monotonicNowNs();
 
 // ioctl, repeated while it fails with EINTR (a signal arrived during the call).
 SysResult ioctlRetry(SysIo& io, int fd, unsigned long request, void* arg);

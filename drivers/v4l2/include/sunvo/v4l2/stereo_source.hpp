@@ -171,7 +171,7 @@ class V4l2StereoSource {
   int bytes_per_pixel_ = 1;
   bool lost_ = false;
   std::string lost_reason_;
-  TimeNs next_reopen_ns_ = 0;  // steady clock
+  TimeNs next_reopen_ns_ = 0;  // sysio::monotonicNowNs()
   int backoff_ms_ = 0;
   int consecutive_timeouts_ = 0;
   // StereoFrame::sequence = sequence_base_ + the left buffer's sequence (which STREAMON restarts

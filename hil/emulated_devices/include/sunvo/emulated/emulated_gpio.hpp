@@ -5,7 +5,7 @@
 // set-value on a line that is not an output, or waiting/reading events on a line not requested
 // for events, is EPERM; closing a chip releases its lines.
 //
-// Output lines record every value written with the steady-clock time of the write. Input lines
+// Output lines record every value written with the monotonic time of the write. Input lines
 // receive edges from strobe()/pushEdge() with the kernel timestamp the test chooses; faults:
 // strobes that never arrive (missed triggers), strobes that arrive twice (duplicate triggers) and
 // a one-shot errno on the next call. Thread-safe: a test thread may strobe while a reader waits.
@@ -27,7 +27,7 @@ namespace sunvo::emulated {
 
 struct GpioWrite {
   int value = 0;
-  TimeNs time_ns = 0;  // steady clock at the write
+  TimeNs time_ns = 0;  // sysio::monotonicNowNs() at the write
 };
 
 class EmulatedGpio final : public gpio::GpioApi {
@@ -51,7 +51,7 @@ class EmulatedGpio final : public gpio::GpioApi {
   Status duplicateStrobes(const std::string& chip, int line, int count, TimeNs gap_ns);
   Status failNextCall(const std::string& chip, int line, int err);
 
-  // Called after every value written to an output line (value, steady-clock time of the write),
+  // Called after every value written to an output line (value, monotonic time of the write),
   // outside the lock: wires a trigger output to emulated cameras, e.g.
   // [&](int v, TimeNs t) { if (v == 1) cameras.trigger(t + exposure_delay); }.
   using OutputListener = std::function<void(int value, TimeNs time_ns)>;
@@ -82,6 +82,8 @@ class EmulatedGpio final : public gpio::GpioApi {
   // Runs change on the named line under the lock, then wakes waiters.
   Status withLine(const std::string& chip, int line, const std::function<void(Line&)>& change);
   int takeFault(Line& l);
+  // lineRequestOutput (output = true) and lineRequestBothEdgesEvents.
+  int request(gpio::LineHandle line, const char* consumer, bool output, int default_value);
 
   mutable std::mutex mutex_;
   std::condition_variable changed_;

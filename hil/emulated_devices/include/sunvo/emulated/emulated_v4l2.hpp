@@ -96,7 +96,8 @@ class EmulatedV4l2 final : public sysio::SysIo {
   EmulatedV4l2Stats stats() const;
   int openFds() const;
   int liveMappings() const;
-  std::vector<TimeNs> openAttempts(const std::string& path) const;  // steady-clock ns
+  std::vector<TimeNs> openAttempts(
+      const std::string& path) const;  // monotonic ns (sysio::monotonicNowNs)
   bool streaming(const std::string& path) const;
   std::uint32_t pixelFormat(const std::string& path) const;
 
