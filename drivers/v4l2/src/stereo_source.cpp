@@ -289,10 +289,11 @@ V4l2StereoSource::Take V4l2StereoSource::takeBuffer(Device& d) {
     }
     d.have_sequence = true;
     d.last_sequence = buf.sequence;
-    Held held{true, buf.index, buf.sequence, buf.bytesused,
+    Held held{true, buf.index, buf.sequence,
               static_cast<TimeNs>(buf.timestamp.tv_sec) * kNsPerSecond +
                   static_cast<TimeNs>(buf.timestamp.tv_usec) * 1000};
     const bool flagged = (buf.flags & V4L2_BUF_FLAG_ERROR) != 0;
+    // bytesused 0: a driver that does not fill it in; the buffer is taken as whole.
     const bool short_buffer = buf.bytesused != 0 && buf.bytesused < d.size_image;
     if (flagged || short_buffer) {
       ++(flagged ? counters_.buffer_errors : counters_.short_buffers);

@@ -131,7 +131,6 @@ class V4l2StereoSource {
     bool valid = false;
     std::uint32_t index = 0;
     std::uint32_t sequence = 0;
-    std::uint32_t bytesused = 0;
     TimeNs time_ns = 0;
   };
   struct Device {
