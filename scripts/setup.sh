@@ -8,6 +8,8 @@ PACKAGES=(
   libgpiod-dev libyaml-cpp-dev libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-ephem povray
 )
+# --train: also the optional Sun-CNN training tools (large; CI only runs OpenCV DNN inference).
+if [ "${1:-}" = "--train" ]; then PACKAGES+=(python3-torch python3-opencv); fi
 
 missing=()
 for p in "${PACKAGES[@]}"; do
