@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Lists the rendered Sun-CNN frames with their labels and hashes the training data.
 
-For every render folder <renders>/{train,val}_*/ (one sunvo_render drive each) it reads
+For every completely rendered folder <renders>/{train,val}_*/ (one sunvo_render drive each,
+marked by the file RENDERED) it reads
 gt/sun_cam0.csv and lists the colour images of both cameras (image_02, image_03: same
 orientation, so the same sun vector in the camera frame). Writes a CSV manifest
     split,scenario,image,sx,sy,sz
@@ -33,8 +34,8 @@ def main():
     train_images, train_labels = [], []
     for render_dir in sorted(glob.glob(os.path.join(a.renders, "train_*")) +
                              glob.glob(os.path.join(a.renders, "val_*"))):
-        if not os.path.isdir(render_dir):
-            continue
+        if not os.path.isfile(os.path.join(render_dir, "RENDERED")):
+            continue  # not (completely) rendered yet: train_sun_cnn.sh writes RENDERED last
         scenario = os.path.basename(render_dir)
         split = "train" if scenario.startswith("train_") else "val"
         d = drive_dir(render_dir)

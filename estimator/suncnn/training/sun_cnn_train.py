@@ -175,7 +175,7 @@ def main():
     ap.add_argument("--manifest", required=True)
     ap.add_argument("--out-dir", required=True)
     ap.add_argument("--reference", required=True)
-    ap.add_argument("--epochs", type=int, default=24)
+    ap.add_argument("--epochs", type=int, default=16)
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--seed", type=int, default=20261122)
     a = ap.parse_args()
