@@ -15,8 +15,8 @@ Status range(const char* key, const char* r) {
   return invalidArgument(std::string("suncnn.") + key + " out of range " + r);
 }
 
-// Circular standard deviation of a mean resultant length R in (0, 1]: sqrt(-2 ln R).
-double circularVariance(double r) {
+// Square of the circular standard deviation of a mean resultant length R in (0, 1]: -2 ln R.
+double circularStdSquared(double r) {
   return -2.0 * std::log(std::clamp(r, 1e-6, 1.0));
 }
 }  // namespace
@@ -188,14 +188,15 @@ Expected<sunfusion::ImageSunEstimate> SunCnnEstimator::estimate(
   }
   raw.r_mc = o.mc_samples > 0 ? std::hypot(sum_c, sum_s) / o.mc_samples : 1.0;
   const bool finite = std::isfinite(raw.c) && std::isfinite(raw.s);
-  raw.r_al = finite ? std::min(std::hypot(raw.c, raw.s), 1.0) : 0.0;
-  raw.sigma_rad =
-      std::clamp(o.sigma_scale * std::sqrt(circularVariance(raw.r_mc) + circularVariance(raw.r_al)),
-                 o.sigma_min_rad, o.sigma_max_rad);
+  if (!finite) raw.c = raw.s = 0.0;  // no direction; sigma goes to its cap below
+  raw.r_al = std::min(std::hypot(raw.c, raw.s), 1.0);
+  raw.sigma_rad = std::clamp(
+      o.sigma_scale * std::sqrt(circularStdSquared(raw.r_mc) + circularStdSquared(raw.r_al)),
+      o.sigma_min_rad, o.sigma_max_rad);
   raw_ = raw;
 
   sunfusion::ImageSunEstimate e;
-  const double az = finite && raw.r_al > 0.0 ? std::atan2(raw.s, raw.c) : 0.0;
+  const double az = raw.r_al > 0.0 ? std::atan2(raw.s, raw.c) : 0.0;
   e.azimuth_deg = az * kRadToDeg;
   if (e.azimuth_deg <= -180.0) e.azimuth_deg += 360.0;
   e.zenith_deg = 90.0;
