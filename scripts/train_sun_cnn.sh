@@ -18,8 +18,7 @@ PY=/usr/bin/python3  # Debian's interpreter, the one python3-torch is installed 
 MODE="${1:-all}"
 
 if [ ! -x "$BUILD/hil/render/sunvo_render" ]; then
-  cmake --preset release >/dev/null
-  cmake --build "$BUILD" --target sunvo_render_tool
+  (cd "$ROOT" && cmake --preset release >/dev/null && cmake --build "$BUILD" --target sunvo_render_tool)
 fi
 
 mkdir -p "$RENDERS"
