@@ -4,7 +4,9 @@
 // top-view plot.
 //
 // Usage: sunvo_replay --drive DIR [--out DIR] [--frames N] [--every N] [--seed N]
-//                     [--drift-deg D] [--paper-form]
+//                     [--drift-deg D] [--paper-form] [--estimators a,b,...]
+//   --estimators  also VO + sun from these image estimators (lalonde, lalonde_vo, sun_cnn) run
+//                 on the drive's colour images; "none" (default) runs the error-model sources
 
 #include <cstdio>
 #include <cstdlib>
@@ -15,6 +17,7 @@
 #include "sunvo/metrics/metrics.hpp"
 #include "sunvo/replay/replay.hpp"
 #include "sunvo/report/report_files.hpp"
+#include "sunvo/sun_estimators/sun_estimators.hpp"
 
 namespace {
 
@@ -22,7 +25,7 @@ int usage(const std::string& msg) {
   std::fprintf(stderr, "sunvo_replay: %s\n", msg.c_str());
   std::fprintf(stderr,
                "usage: sunvo_replay --drive DIR [--out DIR] [--frames N] [--every N] [--seed N] "
-               "[--drift-deg D] [--paper-form]\n");
+               "[--drift-deg D] [--paper-form] [--estimators a,b,...]\n");
   return 2;
 }
 
@@ -40,6 +43,7 @@ int main(int argc, char** argv) {
   sunvo::replay::ReplayOptions options;
   std::string out_dir = "replay_out";
   int seed = 1;
+  std::vector<std::string> estimator_names;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     const bool has_value = i + 1 < argc;
@@ -57,6 +61,14 @@ int main(int argc, char** argv) {
       options.fusion.attitude_drift_deg_per_frame = std::strtod(argv[++i], nullptr);
     } else if (a == "--paper-form") {
       options.fusion.estimate_base_attitude = false;
+    } else if (a == "--estimators" && has_value) {
+      std::string list = argv[++i];
+      for (std::size_t p = 0; p <= list.size();) {
+        const std::size_t q = std::min(list.find(',', p), list.size());
+        if (q > p && list.substr(p, q - p) != "none")
+          estimator_names.push_back(list.substr(p, q - p));
+        p = q + 1;
+      }
     } else {
       return usage("unknown or incomplete argument '" + a + "'");
     }
@@ -78,8 +90,14 @@ int main(int argc, char** argv) {
   input.plane = sunvo::metrics::HorizontalPlane::kEastNorth;
   std::vector<sunvo::report::PlotSeries> series;
   std::vector<sunvo::Isometry3> gt;
-  for (const auto& spec : specs) {
-    auto run = sunvo::replay::replayDrive(options, spec);
+  auto estimators = sunvo::suneval::makeSunEstimators(estimator_names);
+  if (!estimators) return usage(estimators.status().toString());
+  const std::size_t num_runs = specs.size() + estimators->size();
+  for (std::size_t i = 0; i < num_runs; ++i) {
+    const bool image = i >= specs.size();
+    auto run = image ? sunvo::replay::replayDrive(options, std::nullopt,
+                                                  (*estimators)[i - specs.size()].get())
+                     : sunvo::replay::replayDrive(options, specs[i]);
     if (!run) {
       std::fprintf(stderr, "sunvo_replay: %s\n", run.status().toString().c_str());
       return 1;
@@ -95,6 +113,11 @@ int main(int argc, char** argv) {
                  run->name.c_str(), run->T_w_c.size(), run->median_ms, run->p99_ms,
                  run->lost_frames, static_cast<unsigned long long>(run->gate.accepted),
                  static_cast<unsigned long long>(run->gate.total()));
+    if (run->sun_calls > 0) {
+      std::fprintf(stderr, "  %-28s %d estimator calls, %.1f ms median, %.1f ms p90\n", "",
+                   run->sun_calls, sunvo::metrics::percentile(run->sun_ms, 0.5),
+                   sunvo::metrics::percentile(run->sun_ms, 0.9));
+    }
     input.num_poses = run->T_w_c.size();
     input.estimates.push_back({run->name, "", *ev});
     series.push_back({run->name, run->T_w_c});
@@ -103,9 +126,10 @@ int main(int argc, char** argv) {
   if (!table) return usage(table.status().toString());
   std::printf(
       "\n### Replay of %s (%zu frames, %.0f m; sun measurements from the ground truth "
-      "through error models)\n\n%s",
+      "through error models%s)\n\n%s",
       options.drive_dir.c_str(), input.num_poses,
-      input.estimates.front().evaluation.table1.gt_path_length_m, table->c_str());
+      input.estimates.front().evaluation.table1.gt_path_length_m,
+      estimators->empty() ? "" : " and from the image estimators", table->c_str());
   std::printf("\nwrote %s/replay_{table1.md,metrics.json,topview.png}\n", out_dir.c_str());
   return 0;
 }

@@ -23,6 +23,7 @@
 #include <numbers>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <random>
 #include <sstream>
 #include <string>
@@ -30,10 +31,10 @@
 
 #include "datasets.hpp"
 #include "histogram.hpp"
-#include "sun_estimators.hpp"
 #include "sunvo/files/trajectory_io.hpp"
 #include "sunvo/metrics/metrics.hpp"
 #include "sunvo/report/json_writer.hpp"
+#include "sunvo/sun_estimators/sun_estimators.hpp"
 #include "sunvo/sunfusion/sun_gate.hpp"
 #include "sunvo/sunvision/lalonde_debug.hpp"
 
@@ -291,10 +292,15 @@ int run(const Args& args) {
       const double true_az = std::atan2(f.true_sun_c.x(), f.true_sun_c.z()) / kDeg;
       const double true_zen =
           std::acos(std::clamp(f.true_sun_c.dot(f.true_up_c), -1.0, 1.0)) / kDeg;
+      // Sun-CNN takes colour only; a gray frame (the KITTI odometry sample) goes in as three equal
+      // channels. Lalonde handles gray itself (its colour tests are skipped).
+      sunvo::sunfusion::ImageSunInput in_bgr = in;
+      if (image.type() == CV_8UC1) cv::cvtColor(image, in_bgr.color, cv::COLOR_GRAY2BGR);
       for (std::size_t ei = 0; ei < estimators->size(); ++ei) {
         sunvo::sunfusion::ImageSunEstimator& est = *(*estimators)[ei];
+        const bool colour_only = std::string(est.name()) == "sun_cnn";
         const double cpu0 = threadCpuMs();
-        Expected<sunvo::sunfusion::ImageSunEstimate> e = est.estimate(in);
+        Expected<sunvo::sunfusion::ImageSunEstimate> e = est.estimate(colour_only ? in_bgr : in);
         const double cpu_ms = threadCpuMs() - cpu0;
         if (!e) {
           std::fprintf(stderr, "sunvo_sun_eval: %s on %s: %s\n", est.name(), f.image_path.c_str(),
@@ -311,10 +317,13 @@ int run(const Args& args) {
           ++s.valid;
           const Eigen::Vector3d& sun = e->measurement.sun_c;
           az_err = sunvo::sunvision::wrapPi((std::atan2(sun.x(), sun.z()) - true_az * kDeg)) / kDeg;
-          zen_err =
-              std::acos(std::clamp(sun.normalized().dot(f.true_up_c), -1.0, 1.0)) / kDeg - true_zen;
           s.az_err_deg.push_back(az_err);
-          s.zen_err_deg.push_back(zen_err);
+          // An azimuth-only estimate (Sun-CNN) says nothing about the zenith.
+          if (e->measurement.kind == sunvo::sunfusion::SunMeasurementKind::kFull3d) {
+            zen_err = std::acos(std::clamp(sun.normalized().dot(f.true_up_c), -1.0, 1.0)) / kDeg -
+                      true_zen;
+            s.zen_err_deg.push_back(zen_err);
+          }
           if (std::abs(az_err) > 45.0) ++s.gross;
           const auto g = sunvo::sunfusion::gateSunMeasurement(
               gate, f.true_sun_c, f.true_sun_c.dot(f.true_up_c), e->measurement);

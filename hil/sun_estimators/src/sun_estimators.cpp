@@ -1,5 +1,6 @@
-#include "sun_estimators.hpp"
+#include "sunvo/sun_estimators/sun_estimators.hpp"
 
+#include "sunvo/suncnn/sun_cnn_estimator.hpp"
 #include "sunvo/sunvision/lalonde_estimator.hpp"
 
 namespace sunvo::suneval {
@@ -11,15 +12,23 @@ Expected<std::unique_ptr<sunfusion::ImageSunEstimator>> lalonde(sunvision::Lalon
   SUNVO_RETURN_IF_ERROR(e->init());
   return std::unique_ptr<sunfusion::ImageSunEstimator>(std::move(e));
 }
+
+// The shipped model (config/sun_cnn.onnx) with its default options.
+Expected<std::unique_ptr<sunfusion::ImageSunEstimator>> sunCnn() {
+  auto e = std::make_unique<suncnn::SunCnnEstimator>();
+  SUNVO_RETURN_IF_ERROR(e->init(suncnn::SunCnnOptions{}, SUNVO_DEFAULT_SUN_CNN_MODEL));
+  return std::unique_ptr<sunfusion::ImageSunEstimator>(std::move(e));
+}
 }  // namespace
 
 std::vector<std::string> knownSunEstimators() {
-  return {"lalonde", "lalonde_vo"};
+  return {"lalonde", "lalonde_vo", "sun_cnn"};
 }
 
 Expected<std::unique_ptr<sunfusion::ImageSunEstimator>> makeSunEstimator(const std::string& name) {
   if (name == "lalonde") return lalonde(sunvision::LalondePrior::kZenith);
   if (name == "lalonde_vo") return lalonde(sunvision::LalondePrior::kVisualOdometry);
+  if (name == "sun_cnn") return sunCnn();
   return notFound("unknown sun estimator '" + name + "'");
 }
 

@@ -1,5 +1,6 @@
 #pragma once
-// The image sun estimators sunvo_sun_eval knows, by name, each ready to use (initialised).
+// The image sun estimators by name (for sunvo_sun_eval and sunvo_replay), each ready to use
+// (initialised). sun_cnn loads the shipped model config/sun_cnn.onnx.
 
 #include <memory>
 #include <string>
@@ -13,7 +14,7 @@ namespace sunvo::suneval {
 // Names known to makeSunEstimator, in the default evaluation order.
 std::vector<std::string> knownSunEstimators();
 
-// One estimator by name ("lalonde", "lalonde_vo"); not-found error for an unknown name.
+// One estimator by name ("lalonde", "lalonde_vo", "sun_cnn"); not-found error for an unknown name.
 Expected<std::unique_ptr<sunfusion::ImageSunEstimator>> makeSunEstimator(const std::string& name);
 
 // All of `names`, in order; fails on the first unknown or failing one.
