@@ -1,0 +1,139 @@
+// sunvo_rover: the onboard program. Reads the YAML config, starts the capture, estimator, sun
+// and telemetry threads, and runs until SIGINT/SIGTERM (or, for a replay with end: stop, until
+// the last pose is sent). SIGUSR1 writes the latency profile without stopping.
+//
+//   sunvo_rover --config config/rover.yaml [--set key=value ...]
+//
+// Exit codes: 0 clean shutdown, 2 bad command line or config, 1 any other start-up failure.
+
+#include <signal.h>
+
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "sunvo/rover/app.hpp"
+#include "sunvo/rover/config.hpp"
+#ifdef SUNVO_HAVE_MAVLINK
+#include "sunvo/rover/mavlink_link.hpp"
+#endif
+#include "sunvo/runtime/allocation_meter.hpp"
+
+#ifdef SUNVO_ALLOC_COUNTER
+#include "sunvo/bench/alloc_counter.hpp"
+#endif
+
+namespace {
+
+void usage() {
+  std::fprintf(stderr,
+               "usage: sunvo_rover --config FILE [--set key=value]...\n"
+               "  --config FILE     YAML config (config/rover.yaml, config/rover_replay.yaml)\n"
+               "  --set key=value   override one config key, e.g. --set serial.device=/dev/pts/3\n"
+               "signals: SIGINT/SIGTERM stop cleanly, SIGUSR1 writes the latency profile\n");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string config_path;
+  std::vector<std::pair<std::string, std::string>> overrides;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--config" && i + 1 < argc) {
+      config_path = argv[++i];
+    } else if (a == "--set" && i + 1 < argc) {
+      const std::string kv = argv[++i];
+      const auto eq = kv.find('=');
+      if (eq == std::string::npos || eq == 0) {
+        std::fprintf(stderr, "sunvo_rover: --set %s: expected key=value\n", kv.c_str());
+        return 2;
+      }
+      overrides.emplace_back(kv.substr(0, eq), kv.substr(eq + 1));
+    } else if (a == "--help" || a == "-h") {
+      usage();
+      return 0;
+    } else {
+      std::fprintf(stderr, "sunvo_rover: unknown argument '%s'\n", a.c_str());
+      usage();
+      return 2;
+    }
+  }
+  if (config_path.empty()) {
+    usage();
+    return 2;
+  }
+  auto config = sunvo::rover::loadRoverConfig(config_path, overrides);
+  if (!config) {
+    std::fprintf(stderr, "sunvo_rover: %s\n", config.status().message().c_str());
+    return 2;
+  }
+  std::printf("%s", config->describe().c_str());
+
+#ifdef SUNVO_ALLOC_COUNTER
+  sunvo::runtime::setThreadAllocationProbe(&sunvo::bench::threadAllocationCount);
+#endif
+
+  // Signals are blocked in every thread (the threads inherit the mask) and taken here.
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGUSR1);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+
+  std::unique_ptr<sunvo::rover::PoseLink> link;
+  if (!config->serial.device.empty()) {
+#ifndef SUNVO_HAVE_MAVLINK
+    std::fprintf(stderr, "sunvo_rover: serial.device: no MAVLink link in this build\n");
+    return 1;
+#else
+    auto l = sunvo::rover::MavlinkSerialLink::open(config->serial, config->telemetry);
+    if (!l) {
+      std::fprintf(stderr, "sunvo_rover: serial.device: %s\n", l.status().message().c_str());
+      return 1;
+    }
+    link = std::move(*l);
+#endif
+  }
+  auto app = sunvo::rover::RoverApp::create(*config, std::move(link));
+  if (!app) {
+    std::fprintf(stderr, "sunvo_rover: %s\n", app.status().message().c_str());
+    return app.status().code() == sunvo::StatusCode::kInvalidArgument ? 2 : 1;
+  }
+  for (const std::string& w : (*app)->start()) std::fprintf(stderr, "sunvo_rover: %s\n", w.c_str());
+  std::printf("sunvo_rover: running (pid %d)\n", static_cast<int>(getpid()));
+  std::fflush(stdout);
+
+  int dumps = 0;
+  const char* reason = "end of the replay";
+  for (;;) {
+    timespec tick{0, 50'000'000};
+    const int sig = sigtimedwait(&signals, nullptr, &tick);
+    if (sig == SIGUSR1) {
+      auto text = (*app)->writeProfile("sigusr1_" + std::to_string(++dumps));
+      std::fprintf(stderr, "sunvo_rover: SIGUSR1: profile %s\n",
+                   text ? "written" : text.status().message().c_str());
+      continue;
+    }
+    if (sig == SIGINT || sig == SIGTERM) {
+      reason = sig == SIGINT ? "SIGINT" : "SIGTERM";
+      break;
+    }
+    if ((*app)->finished()) break;
+  }
+  (*app)->requestStop();
+  (*app)->join();
+  auto profile = (*app)->writeProfile("final");
+  std::printf("sunvo_rover: stopped (%s)\n%s", reason, (*app)->summary().c_str());
+  if (!profile) {
+    std::fprintf(stderr, "sunvo_rover: profile: %s\n", profile.status().message().c_str());
+  } else {
+    std::printf("  profile: %s/final_latency.csv, final_trace.json, final_latency_summary.txt\n",
+                config->profiling.output_dir.c_str());
+  }
+  std::fflush(stdout);
+  return 0;
+}
