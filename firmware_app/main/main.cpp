@@ -27,6 +27,19 @@
 
 namespace {
 
+// Resident set size of this process, kB (VmRSS of /proc/self/status); -1 if unreadable.
+long residentKb() {
+  std::FILE* f = std::fopen("/proc/self/status", "r");
+  if (f == nullptr) return -1;
+  char line[256];
+  long kb = -1;
+  while (std::fgets(line, sizeof(line), f) != nullptr) {
+    if (std::strncmp(line, "VmRSS:", 6) == 0) kb = std::strtol(line + 6, nullptr, 10);
+  }
+  std::fclose(f);
+  return kb;
+}
+
 void usage() {
   std::fprintf(stderr,
                "usage: sunvo_rover --config FILE [--set key=value]...\n"
@@ -103,10 +116,15 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "sunvo_rover: %s\n", app.status().message().c_str());
     return app.status().code() == sunvo::StatusCode::kInvalidArgument ? 2 : 1;
   }
+  const long rss_start_kb = residentKb();  // every buffer allocated, threads not started
   for (const std::string& w : (*app)->start()) std::fprintf(stderr, "sunvo_rover: %s\n", w.c_str());
   std::printf("sunvo_rover: running (pid %d)\n", static_cast<int>(getpid()));
   std::fflush(stdout);
 
+  // RSS once the warm-up frames are through, and at the end: growth = a leak or a buffer that grows.
+  const auto warmup = static_cast<std::uint64_t>(config->estimator.warmup_frames);
+  long rss_warm_kb = -1;
+  std::uint64_t rss_warm_frame = 0;
   int dumps = 0;
   const char* reason = "end of the replay";
   for (;;) {
@@ -122,12 +140,26 @@ int main(int argc, char** argv) {
       reason = sig == SIGINT ? "SIGINT" : "SIGTERM";
       break;
     }
+    if (rss_warm_kb < 0 && (*app)->framesProcessed() >= warmup) {
+      rss_warm_frame = (*app)->framesProcessed();
+      rss_warm_kb = residentKb();
+    }
     if ((*app)->finished()) break;
   }
   (*app)->requestStop();
   (*app)->join();
+  const long rss_end_kb = residentKb();
   auto profile = (*app)->writeProfile("final");
   std::printf("sunvo_rover: stopped (%s)\n%s", reason, (*app)->summary().c_str());
+  if (rss_warm_kb >= 0) {
+    std::printf("  rss: %ld kB at start, %ld kB after warm-up (frame %llu), %ld kB at the end: "
+                "growth after warm-up %ld kB\n",
+                rss_start_kb, rss_warm_kb, static_cast<unsigned long long>(rss_warm_frame), rss_end_kb,
+                rss_end_kb - rss_warm_kb);
+  } else {
+    std::printf("  rss: %ld kB at start, %ld kB at the end (warm-up not reached)\n", rss_start_kb,
+                rss_end_kb);
+  }
   if (!profile) {
     std::fprintf(stderr, "sunvo_rover: profile: %s\n", profile.status().message().c_str());
   } else {

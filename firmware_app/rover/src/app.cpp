@@ -685,6 +685,10 @@ Expected<std::string> RoverApp::writeProfile(const std::string& tag) const {
   return text;
 }
 
+std::uint64_t RoverApp::framesProcessed() const {
+  return impl_->health.frames_processed.load(std::memory_order_relaxed);
+}
+
 std::string RoverApp::summary() const {
   const Impl& s = *impl_;
   const Health& h = s.health;

@@ -59,6 +59,9 @@ class RoverApp {
   // Latency CSV, Chrome trace and stage summary into profiling.output_dir, named <tag>_*.
   // Returns the stage summary text. Safe while running (SIGUSR1).
   Expected<std::string> writeProfile(const std::string& tag) const;
+  // Frames the estimator has processed so far (any thread).
+  std::uint64_t framesProcessed() const;
+
   // Final summary: frames, drops per queue, deadline misses, tracking, sun, serial, latency.
   std::string summary() const;
 
