@@ -8,6 +8,8 @@ PACKAGES=(
   libgpiod-dev libyaml-cpp-dev libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-ephem povray
 )
+# node-mavlink (npm) decodes our MAVLink stream in the tests; installed only when node/npm is missing.
+if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then PACKAGES+=(nodejs npm); fi
 
 missing=()
 for p in "${PACKAGES[@]}"; do
