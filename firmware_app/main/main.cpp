@@ -16,9 +16,7 @@
 
 #include "sunvo/rover/app.hpp"
 #include "sunvo/rover/config.hpp"
-#ifdef SUNVO_HAVE_MAVLINK
 #include "sunvo/rover/mavlink_link.hpp"
-#endif
 #include "sunvo/runtime/allocation_meter.hpp"
 
 #ifdef SUNVO_ALLOC_COUNTER
@@ -99,17 +97,12 @@ int main(int argc, char** argv) {
 
   std::unique_ptr<sunvo::rover::PoseLink> link;
   if (!config->serial.device.empty()) {
-#ifndef SUNVO_HAVE_MAVLINK
-    std::fprintf(stderr, "sunvo_rover: serial.device: no MAVLink link in this build\n");
-    return 1;
-#else
     auto l = sunvo::rover::MavlinkSerialLink::open(config->serial, config->telemetry);
     if (!l) {
       std::fprintf(stderr, "sunvo_rover: serial.device: %s\n", l.status().message().c_str());
       return 1;
     }
     link = std::move(*l);
-#endif
   }
   auto app = sunvo::rover::RoverApp::create(*config, std::move(link));
   if (!app) {
@@ -121,7 +114,8 @@ int main(int argc, char** argv) {
   std::printf("sunvo_rover: running (pid %d)\n", static_cast<int>(getpid()));
   std::fflush(stdout);
 
-  // RSS once the warm-up frames are through, and at the end: growth = a leak or a buffer that grows.
+  // RSS once the warm-up frames are through, and at the end: growth = a leak or a buffer that
+  // grows.
   const auto warmup = static_cast<std::uint64_t>(config->estimator.warmup_frames);
   long rss_warm_kb = -1;
   std::uint64_t rss_warm_frame = 0;
@@ -152,10 +146,11 @@ int main(int argc, char** argv) {
   auto profile = (*app)->writeProfile("final");
   std::printf("sunvo_rover: stopped (%s)\n%s", reason, (*app)->summary().c_str());
   if (rss_warm_kb >= 0) {
-    std::printf("  rss: %ld kB at start, %ld kB after warm-up (frame %llu), %ld kB at the end: "
-                "growth after warm-up %ld kB\n",
-                rss_start_kb, rss_warm_kb, static_cast<unsigned long long>(rss_warm_frame), rss_end_kb,
-                rss_end_kb - rss_warm_kb);
+    std::printf(
+        "  rss: %ld kB at start, %ld kB after warm-up (frame %llu), %ld kB at the end: "
+        "growth after warm-up %ld kB\n",
+        rss_start_kb, rss_warm_kb, static_cast<unsigned long long>(rss_warm_frame), rss_end_kb,
+        rss_end_kb - rss_warm_kb);
   } else {
     std::printf("  rss: %ld kB at start, %ld kB at the end (warm-up not reached)\n", rss_start_kb,
                 rss_end_kb);

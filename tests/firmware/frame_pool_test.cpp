@@ -32,7 +32,7 @@ TEST(FramePool, SlotsAreAllocatedOnceAndHandedOutUntilExhausted) {
   ASSERT_TRUE(p.acquire(&i));
   EXPECT_EQ(i, 1u);
   EXPECT_EQ(p.slot(1).frame.left.data, data);  // the same buffer, not a new one
-  p.recycle(1);  // the producer's own drop
+  p.recycle(1);                                // the producer's own drop
   EXPECT_EQ(p.freeCount(), 1u);
 }
 

@@ -103,8 +103,10 @@ TEST(LatencyProfiler, CsvAndChromeTrace) {
                       "\"ts\":102000.000,\"dur\":2000.000"),
             std::string::npos);
   // A real JSON parser must accept it (Perfetto and chrome://tracing load this format).
-  const std::string cmd = "python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); "
-                          "assert len(d[\"traceEvents\"]) == 23' " + trace;
+  const std::string cmd =
+      "python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); "
+      "assert len(d[\"traceEvents\"]) == 23' " +
+      trace;
   EXPECT_EQ(std::system(cmd.c_str()), 0);
   EXPECT_FALSE(LatencyProfiler::writeCsv("/nonexistent/dir/x.csv", frames).isOk());
 }

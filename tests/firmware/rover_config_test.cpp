@@ -1,9 +1,9 @@
-#include "sunvo/rover/config.hpp"
-
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
+
+#include "sunvo/rover/config.hpp"
 
 namespace sunvo::rover {
 namespace {
@@ -86,8 +86,7 @@ TEST(RoverConfig, ErrorsNameTheFileTheKeyAndTheLine) {
 
   auto q = loadRoverConfig(path, {{"queues.frames", "3"}});
   ASSERT_FALSE(q);
-  EXPECT_NE(q.status().message().find("queues.frames: 3 is not a power of two"),
-            std::string::npos);
+  EXPECT_NE(q.status().message().find("queues.frames: 3 is not a power of two"), std::string::npos);
 
   auto depth = loadRoverConfig(path, {{"queues.frames", "8"}});
   ASSERT_FALSE(depth);

@@ -82,9 +82,10 @@ TEST(RoverReplay, WholeProgramIntoAPseudoTerminal) {
       " --child-log " + (out / "rover.log").string() + " --latency-csv " +
       (out / "final_latency.csv").string() + " -- " + emu + bin +
       "/firmware_app/main/sunvo_rover --config " + SUNVO_SOURCE_DIR +
-      "/config/rover_replay.yaml --set source.kitti.drive_dir=" + drive + " --set sun.csv=" +
-      drive + "/gt/sun_cam0.csv --set serial.device={pty} --set profiling.output_dir=" +
-      out.string() + " > " + (out / "reader.txt").string() + " 2>&1";
+      "/config/rover_replay.yaml --set source.kitti.drive_dir=" + drive +
+      " --set sun.csv=" + drive +
+      "/gt/sun_cam0.csv --set serial.device={pty} --set profiling.output_dir=" + out.string() +
+      " > " + (out / "reader.txt").string() + " 2>&1";
   const int rc = std::system(cmd.c_str());
   std::stringstream json_text, log_text;
   json_text << std::ifstream(out / "reader.json").rdbuf();

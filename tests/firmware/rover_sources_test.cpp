@@ -1,6 +1,6 @@
-#include "sunvo/rover/sources.hpp"
-
 #include <gtest/gtest.h>
+
+#include "sunvo/rover/sources.hpp"
 
 namespace sunvo::rover {
 namespace {
@@ -11,10 +11,10 @@ TEST(TriggerMonitor, CountsMissedAndDuplicateTriggersOnFakeTimestamps) {
   TriggerMonitor m(kP);
   const TimeNs t0 = 5'000'000'000;
   m.observe(t0);
-  m.observe(t0 + kP);                // regular
-  m.observe(t0 + kP + 3'000'000);    // 3 ms later: a duplicate edge
-  m.observe(t0 + 2 * kP + 4'000'000);  // regular (jitter 4 ms)
-  m.observe(t0 + 5 * kP);            // 3 periods: 2 missed
+  m.observe(t0 + kP);                   // regular
+  m.observe(t0 + kP + 3'000'000);       // 3 ms later: a duplicate edge
+  m.observe(t0 + 2 * kP + 4'000'000);   // regular (jitter 4 ms)
+  m.observe(t0 + 5 * kP);               // 3 periods: 2 missed
   m.observe(t0 + 6 * kP + 40'000'000);  // 1.4 periods: rounds to 1, none missed
   EXPECT_EQ(m.duplicates(), 1u);
   EXPECT_EQ(m.missed(), 2u);
@@ -42,9 +42,11 @@ TEST(ReplaySchedule, PingPongAndLoopKeepTimeMovingForward) {
   for (std::uint64_t k = 0; k < 10; ++k) {
     EXPECT_TRUE(pp.has(k));
     EXPECT_EQ(pp.recordingIndex(k), expected[k]) << k;
-    if (k > 0) EXPECT_GT(pp.utcNs(k), pp.utcNs(k - 1));
+    if (k > 0) {
+      EXPECT_GT(pp.utcNs(k), pp.utcNs(k - 1));
+    }
   }
-  EXPECT_FALSE(pp.has(10));  // total_frames
+  EXPECT_FALSE(pp.has(10));                         // total_frames
   EXPECT_EQ(pp.offsetNs(5), 309'000'000 + 2 * kP);  // the first pass, then the nominal period
   ReplaySchedule loop(recording(3), 0, EndAction::kLoop, 0, kP, false);
   EXPECT_EQ(loop.recordingIndex(3), 0);
@@ -54,8 +56,8 @@ TEST(ReplaySchedule, PingPongAndLoopKeepTimeMovingForward) {
 }
 
 TEST(SimulatedTrigger, FiresAtTheScheduleAndEnds) {
-  auto schedule = std::make_shared<ReplaySchedule>(recording(3), 0, EndAction::kStop, 0,
-                                                   10'000'000, false);  // 100 Hz
+  auto schedule = std::make_shared<ReplaySchedule>(recording(3), 0, EndAction::kStop, 0, 10'000'000,
+                                                   false);  // 100 Hz
   SimulatedTrigger trigger(schedule);
   TriggerEvent ev;
   std::vector<TriggerEvent> events;

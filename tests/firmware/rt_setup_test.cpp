@@ -35,8 +35,7 @@ TEST(RtSetup, PolicyIsAppliedOrExplainedInOneLine) {
                 .find("rt.threads.x.fifo_priority: 100 is outside [0, 99]"),
             std::string::npos);
   const ThreadPolicy bad_cpu{0, -2};
-  EXPECT_NE(bad_cpu.validate("rt.threads.x").message().find("rt.threads.x.cpu"),
-            std::string::npos);
+  EXPECT_NE(bad_cpu.validate("rt.threads.x").message().find("rt.threads.x.cpu"), std::string::npos);
 }
 
 }  // namespace

@@ -1,7 +1,7 @@
 // sunvo_pose_reader: the other end of sunvo_rover's serial port, for whole-program replays.
 //
-//   sunvo_pose_reader --drive DIR --frames N [options] -- sunvo_rover --config ... \
-//                     --set serial.device={pty} ...
+//   sunvo_pose_reader --drive DIR --frames N [options] --
+//                     sunvo_rover --config ... --set serial.device={pty} ...
 //
 // It opens a pseudo-terminal pair, starts the command with {pty} replaced by the slave's path,
 // decodes the MAVLink stream on the master (drivers/mavlink's decoder: CRC, sequence numbers),
@@ -58,7 +58,7 @@ struct Options {
   double timeout_s = 60.0;
   std::string json;
   std::string child_log;
-  std::string latency_csv;  // the program's final_latency.csv
+  std::string latency_csv;          // the program's final_latency.csv
   double max_final_drift_m = -1.0;  // < 0: not checked
   double max_rot_armse_rad = -1.0;
   std::vector<std::string> command;
@@ -123,8 +123,8 @@ sunvo::Isometry3 poseFromOdometry(const sunvo::mavlink::Odometry& m) {
   const Eigen::Quaterniond q_l_b(m.q[0], m.q[1], m.q[2], m.q[3]);
   sunvo::Isometry3 T = sunvo::Isometry3::Identity();
   T.translation() = C_l_w.transpose() * Eigen::Vector3d(m.x, m.y, m.z);
-  T.linear() = sunvo::orthonormalize(C_l_w.transpose() * q_l_b.normalized().toRotationMatrix() *
-                                     C_b_c);
+  T.linear() =
+      sunvo::orthonormalize(C_l_w.transpose() * q_l_b.normalized().toRotationMatrix() * C_b_c);
   return T;
 }
 
@@ -196,7 +196,7 @@ int main(int argc, char** argv) {
   std::vector<Received> poses;
   poses.reserve(static_cast<std::size_t>(opt.frames) + 16);
   std::uint64_t heartbeats = 0, duplicates = 0, unknown_times = 0;
-  std::map<std::uint64_t, int> times_seen;  // time_usec -> count
+  std::map<std::uint64_t, int> times_seen;     // time_usec -> count
   std::map<std::uint64_t, int> index_of_time;  // time_usec -> frame index
   for (std::size_t k = 0; k < truth->times_ns.size(); ++k) {
     index_of_time[static_cast<std::uint64_t>(truth->times_ns[k] / 1000)] = static_cast<int>(k);
@@ -315,11 +315,13 @@ int main(int argc, char** argv) {
         const TimeNs utc = std::atoll(std::string(f[1]).c_str());
         const TimeNs trig = std::atoll(std::string(f[2]).c_str());
         const TimeNs last = std::atoll(std::string(f[11]).c_str());
-        if (trig > 0 && last >= trig) to_written_ms.push_back(static_cast<double>(last - trig) * 1e-6);
+        if (trig > 0 && last >= trig)
+          to_written_ms.push_back(static_cast<double>(last - trig) * 1e-6);
         auto it = recv_of_time.find(static_cast<std::uint64_t>(utc / 1000));
         if (it == recv_of_time.end()) continue;
         const TimeNs recv = it->second;
-        if (trig > 0 && recv >= trig) to_received_ms.push_back(static_cast<double>(recv - trig) * 1e-6);
+        if (trig > 0 && recv >= trig)
+          to_received_ms.push_back(static_cast<double>(recv - trig) * 1e-6);
       }
     } else {
       std::fprintf(stderr, "sunvo_pose_reader: %s: not readable\n", opt.latency_csv.c_str());
@@ -341,9 +343,11 @@ int main(int argc, char** argv) {
   std::snprintf(
       json, sizeof(json),
       "{\n  \"frames_expected\": %d,\n  \"odometry_received\": %zu,\n  \"missing\": %d,\n"
-      "  \"duplicates\": %" PRIu64 ",\n  \"unknown_times\": %" PRIu64 ",\n"
+      "  \"duplicates\": %" PRIu64 ",\n  \"unknown_times\": %" PRIu64
+      ",\n"
       "  \"heartbeats\": %" PRIu64 ",\n  \"crc_errors\": %" PRIu64 ",\n  \"seq_gaps\": %" PRIu64
-      ",\n  \"frames_ok\": %" PRIu64 ",\n  \"clean_exit\": %s,\n  \"summary_printed\": %s,\n"
+      ",\n  \"frames_ok\": %" PRIu64
+      ",\n  \"clean_exit\": %s,\n  \"summary_printed\": %s,\n"
       "  \"evaluated\": %s,\n  \"trans_armse_m\": %.6f,\n  \"rot_armse_rad\": %.8f,\n"
       "  \"final_drift_m\": %.6f,\n  \"final_drift_pct\": %.4f,\n  \"path_length_m\": %.4f,\n"
       "  \"trigger_to_written_ms\": {\"n\": %zu, \"p50\": %.3f, \"p95\": %.3f, \"p99\": %.3f, "
@@ -351,10 +355,10 @@ int main(int argc, char** argv) {
       "  \"trigger_to_received_ms\": {\"n\": %zu, \"p50\": %.3f, \"p95\": %.3f, \"p99\": %.3f, "
       "\"max\": %.3f},\n  \"ok\": %s\n}\n",
       opt.frames, poses.size(), missing, duplicates, unknown_times, heartbeats, dc.crc_errors,
-      dc.seq_gaps, dc.frames_ok, clean_exit ? "true" : "false",
-      summary_printed ? "true" : "false", evaluated ? "true" : "false", t1.trans_armse_m,
-      t1.rot_armse_rad, t1.final_drift_m, t1.final_drift_pct, t1.gt_path_length_m,
-      to_written_ms.size(), percentileMs(to_written_ms, 0.5), percentileMs(to_written_ms, 0.95),
+      dc.seq_gaps, dc.frames_ok, clean_exit ? "true" : "false", summary_printed ? "true" : "false",
+      evaluated ? "true" : "false", t1.trans_armse_m, t1.rot_armse_rad, t1.final_drift_m,
+      t1.final_drift_pct, t1.gt_path_length_m, to_written_ms.size(),
+      percentileMs(to_written_ms, 0.5), percentileMs(to_written_ms, 0.95),
       percentileMs(to_written_ms, 0.99),
       to_written_ms.empty() ? 0.0 : *std::max_element(to_written_ms.begin(), to_written_ms.end()),
       to_received_ms.size(), percentileMs(to_received_ms, 0.5), percentileMs(to_received_ms, 0.95),
