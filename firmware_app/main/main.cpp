@@ -18,6 +18,7 @@
 #include "sunvo/rover/config.hpp"
 #include "sunvo/rover/mavlink_link.hpp"
 #include "sunvo/runtime/allocation_meter.hpp"
+#include "sunvo/runtime/rt_setup.hpp"
 
 #ifdef SUNVO_ALLOC_COUNTER
 #include "sunvo/bench/alloc_counter.hpp"
@@ -83,6 +84,11 @@ int main(int argc, char** argv) {
   }
   std::printf("%s", config->describe().c_str());
 
+  // Before any thread exists: one malloc arena, no mmap blocks, no trimming.
+  if (config->rt.heap_reserve_mb > 0) {
+    const std::string w = sunvo::runtime::configureRealTimeHeap();
+    if (!w.empty()) std::fprintf(stderr, "sunvo_rover: %s\n", w.c_str());
+  }
 #ifdef SUNVO_ALLOC_COUNTER
   sunvo::runtime::setThreadAllocationProbe(&sunvo::bench::threadAllocationCount);
 #endif
@@ -108,6 +114,11 @@ int main(int argc, char** argv) {
   if (!app) {
     std::fprintf(stderr, "sunvo_rover: %s\n", app.status().message().c_str());
     return app.status().code() == sunvo::StatusCode::kInvalidArgument ? 2 : 1;
+  }
+  {
+    const std::string w =
+        sunvo::runtime::reserveHeap(static_cast<std::size_t>(config->rt.heap_reserve_mb) << 20);
+    if (!w.empty()) std::fprintf(stderr, "sunvo_rover: %s\n", w.c_str());
   }
   const long rss_start_kb = residentKb();  // every buffer allocated, threads not started
   for (const std::string& w : (*app)->start()) std::fprintf(stderr, "sunvo_rover: %s\n", w.c_str());

@@ -250,6 +250,7 @@ Status readAll(Reader& r, const YAML::Node& root, RoverConfig* c) {
   // rt
   SUNVO_RETURN_IF_ERROR(r.section(root, "", "rt", &n));
   SUNVO_RETURN_IF_ERROR(r.get(n, "rt", "lock_memory", &c->rt.lock_memory));
+  SUNVO_RETURN_IF_ERROR(r.get(n, "rt", "heap_reserve_mb", &c->rt.heap_reserve_mb));
   SUNVO_RETURN_IF_ERROR(r.section(n, "rt", "threads", &m));
   SUNVO_RETURN_IF_ERROR(readThread(r, m, "capture", &c->rt.capture));
   SUNVO_RETURN_IF_ERROR(readThread(r, m, "estimator", &c->rt.estimator));
@@ -346,6 +347,7 @@ Status RoverConfig::validate() const {
       checkOpenLow("telemetry.attitude_sigma_deg", telemetry.attitude_sigma_deg, 0.0, 180.0));
   SUNVO_RETURN_IF_ERROR(
       checkRange("telemetry.full_quality_inliers", telemetry.full_quality_inliers, 1, 100000));
+  SUNVO_RETURN_IF_ERROR(checkRange("rt.heap_reserve_mb", rt.heap_reserve_mb, 0, 4096));
   SUNVO_RETURN_IF_ERROR(rt.capture.validate("rt.threads.capture"));
   SUNVO_RETURN_IF_ERROR(rt.estimator.validate("rt.threads.estimator"));
   SUNVO_RETURN_IF_ERROR(rt.sun.validate("rt.threads.sun"));

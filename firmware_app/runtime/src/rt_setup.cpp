@@ -1,10 +1,13 @@
 #include "sunvo/runtime/rt_setup.hpp"
 
+#include <malloc.h>
 #include <pthread.h>
 #include <sched.h>
 #include <sys/mman.h>
+#include <unistd.h>
 
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 
 #include "sunvo/runtime/clock.hpp"
@@ -35,6 +38,29 @@ std::string lockProcessMemory() {
   const int e = errno;
   return "warning: rt.lock_memory: mlockall(MCL_CURRENT|MCL_FUTURE) failed: " + errnoText(e) +
          "; pages may be swapped out (needs CAP_IPC_LOCK or a larger RLIMIT_MEMLOCK)";
+}
+
+std::string configureRealTimeHeap() {
+  // mallopt returns 1 on success.
+  if (mallopt(M_ARENA_MAX, 1) != 1 || mallopt(M_MMAP_MAX, 0) != 1 ||
+      mallopt(M_TRIM_THRESHOLD, -1) != 1) {
+    return "warning: rt.heap_reserve_mb: mallopt (M_ARENA_MAX, M_MMAP_MAX, M_TRIM_THRESHOLD) "
+           "failed; the heap may keep growing";
+  }
+  return {};
+}
+
+std::string reserveHeap(std::size_t bytes) {
+  if (bytes == 0) return {};
+  auto* p = static_cast<volatile char*>(std::malloc(bytes));
+  if (p == nullptr) {
+    return "warning: rt.heap_reserve_mb: could not reserve " + std::to_string(bytes >> 20) +
+           " MiB; the heap may grow while running";
+  }
+  const auto page = static_cast<std::size_t>(sysconf(_SC_PAGESIZE));
+  for (std::size_t i = 0; i < bytes; i += page) p[i] = 0;
+  std::free(const_cast<char*>(p));
+  return {};
 }
 
 std::string applyThreadPolicy(const std::string& key, const std::string& thread_name,

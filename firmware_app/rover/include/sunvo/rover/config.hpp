@@ -124,6 +124,9 @@ struct TelemetryConfig {
 
 struct RtConfig {
   bool lock_memory = true;  // mlockall(MCL_CURRENT | MCL_FUTURE)
+  // MiB, [0, 4096]: heap made resident at start-up for the estimator's per-frame allocations
+  // (one malloc arena, no mmap blocks, no trimming; see runtime::configureRealTimeHeap); 0 = off
+  int heap_reserve_mb = 64;
   runtime::ThreadPolicy capture{80, -1};
   runtime::ThreadPolicy estimator{70, -1};
   runtime::ThreadPolicy sun{20, -1};

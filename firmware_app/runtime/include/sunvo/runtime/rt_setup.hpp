@@ -19,6 +19,14 @@ struct ThreadPolicy {
 
 // mlockall(MCL_CURRENT | MCL_FUTURE).
 std::string lockProcessMemory();
+
+// A heap whose resident size stops growing (glibc): one arena for all threads, large blocks from
+// the heap instead of mmap (a freed mmap block is unmapped and faulted in again next time), and
+// the top of the heap never trimmed. Call before any thread is started.
+std::string configureRealTimeHeap();
+// Grows the heap by `bytes`, touches every page and frees it again: later allocations (the
+// estimator's bounded per-frame ones) are served from resident pages instead of growing RSS.
+std::string reserveHeap(std::size_t bytes);
 // Applies the policy to the calling thread and names it (pthread_setname_np, <= 15 chars).
 std::string applyThreadPolicy(const std::string& key, const std::string& thread_name,
                               const ThreadPolicy& policy);
