@@ -15,6 +15,7 @@
 #include "sunvo/pipeline/stereo_visual_odometry.hpp"
 #include "sunvo/runtime/allocation_meter.hpp"
 #include "sunvo/runtime/clock.hpp"
+#include "sunvo/runtime/deadline.hpp"
 #include "sunvo/runtime/event_count.hpp"
 #include "sunvo/runtime/latency_profiler.hpp"
 #include "sunvo/runtime/spsc_queue.hpp"
@@ -290,8 +291,6 @@ void RoverApp::Impl::takeSunResults(std::uint64_t waiting_for, bool* got) {
 
 void RoverApp::Impl::estimatorLoop() {
   const EstimatorConfig& ec = config.estimator;
-  const auto deadline_ns = static_cast<TimeNs>(ec.deadline_ms * 1e6);
-  const auto margin_ns = static_cast<TimeNs>(ec.publish_margin_ms * 1e6);
   const auto sun_wait_ns = static_cast<TimeNs>(config.sun.wait_ms * 1e6);
   double front_ms_mean = 0.0;  // running mean of front end + RANSAC, ms
   bool have_prev = false;
@@ -323,9 +322,9 @@ void RoverApp::Impl::estimatorLoop() {
     // Solver budget from the frame's age.
     const TimeNs age = t_start - slot.meta.trigger_mono_ns;
     if (age > period_ns) health.late_frames.fetch_add(1, std::memory_order_relaxed);
-    const double remaining_ms =
-        static_cast<double>(deadline_ns - age - margin_ns) * 1e-6 - front_ms_mean;
-    const double budget_ms = std::clamp(remaining_ms, ec.min_solver_time_ms, ec.max_solver_time_ms);
+    const double budget_ms =
+        runtime::solverBudgetMs(ec.deadline_ms, static_cast<double>(age) * 1e-6, front_ms_mean,
+                                ec.publish_margin_ms, ec.min_solver_time_ms, ec.max_solver_time_ms);
     if (budget_ms < ec.max_solver_time_ms) {
       health.shrunk_budgets.fetch_add(1, std::memory_order_relaxed);
     }
@@ -405,8 +404,7 @@ void RoverApp::Impl::estimatorLoop() {
     pose.tracking = static_cast<int>(status);
     pose.ransac_inliers = r->vo.ransac_inliers;
     pose.reset_counter = reset_counter;
-    PoseRecord dropped;
-    poses_q.push(pose, &dropped);
+    poses_q.push(pose);  // drop-oldest: a stale pose is of no use
     poses_ev.notify();
     health.frames_processed.fetch_add(1, std::memory_order_relaxed);
     have_prev = true;
