@@ -51,7 +51,8 @@ class RoverApp {
   std::vector<std::string> start();
   // Asks every thread to finish: capture stops, queued frames are dropped, queued poses are sent.
   void requestStop();
-  // True when a stop/hold... replay's last pose has been published (end: stop), or after stop.
+  // True once the telemetry thread has finished: after requestStop(), or when a replay with
+  // end: stop has published its last pose (never for end: hold before a stop).
   bool finished() const;
   // Waits for the threads (after requestStop() or finished()).
   void join();
