@@ -80,7 +80,7 @@ set(SUNVO_DEB_DEPENDS
     "libstdc++6 (>= 12.2.0)")
 
 # Libraries only some programs link (sunvo_rover: the YAML config; the GPIO driver once it is
-# linked): their package is added when a packaged program links them, found by walking the
+# linked; OpenCV's dnn module through the Sun-CNN estimator): their package is added when a packaged program links them, found by walking the
 # programs' link libraries (static sunvo libraries pass theirs on as $<LINK_ONLY:...>).
 function(_sunvo_link_closure target out_var)
   set(seen ${${out_var}})
@@ -116,6 +116,9 @@ foreach(_program IN LISTS _sunvo_programs)
 endforeach()
 if("yaml-cpp" IN_LIST _sunvo_linked)
   list(APPEND SUNVO_DEB_DEPENDS "libyaml-cpp0.7 (>= 0.7.0)")
+endif()
+if("opencv_dnn" IN_LIST _sunvo_linked)
+  list(APPEND SUNVO_DEB_DEPENDS "libopencv-dnn406 (>= 4.6.0)")
 endif()
 if(SUNVO_GPIOD_LIBRARY AND "${SUNVO_GPIOD_LIBRARY}" IN_LIST _sunvo_linked)
   list(APPEND SUNVO_DEB_DEPENDS "libgpiod2 (>= 1.6.3)")

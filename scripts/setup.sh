@@ -10,6 +10,8 @@ PACKAGES=(
 )
 # node-mavlink (npm) decodes our MAVLink stream in the tests; installed only when node/npm is missing.
 if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then PACKAGES+=(nodejs npm); fi
+# --train: also the optional Sun-CNN training tools (large; CI only runs OpenCV DNN inference).
+if [ "${1:-}" = "--train" ]; then PACKAGES+=(python3-torch python3-opencv); fi
 
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -316,5 +316,55 @@ TEST(BundleWindow, DegenerateInputFailsWithoutTouchingThePoses) {
   EXPECT_EQ(w.addFrame(2, 2, many, guess).code(), StatusCode::kInvalidArgument);
 }
 
+// The per-solve time budget: clamped to the configured limit, restored by a bad value, and a
+// budget far below one iteration's time stops Ceres before it converges (a real-time caller
+// shrinks it for a late frame).
+TEST(BundleWindow, SolverTimeBudgetBoundsTheSolve) {
+  const auto cam = kittiCamera();
+  testing::SceneOptions so;
+  so.pixel_noise_px = 0.5;
+  so.seed = 7;
+  so.max_per_frame = 300;
+  const Isometry3 T_k_km1 = testing::forwardMotion(1.0, 1.0, 0.2);
+  const auto T_w_k = testing::trajectory(2, T_k_km1);
+  const auto pts = testing::makeLandmarks(so, 2.0);
+  WindowOptions wo;
+  wo.max_num_iterations = 50;
+  wo.max_solver_time_in_seconds = 1.0;
+  Isometry3 guess = T_k_km1;
+  guess.linear() = expSO3(Eigen::Vector3d(0.0, 2.0 * M_PI / 180.0, 0.0)) * guess.linear();
+  guess.translation() += Eigen::Vector3d(0.2, -0.1, 0.3);
+  auto solveWith = [&](double budget_s, double* applied_s) {
+    BundleWindow w;
+    EXPECT_TRUE(w.init(wo, cam).isOk());
+    w.reset(Isometry3::Identity());
+    w.setSolverTimeBudget(budget_s);
+    *applied_s = w.solverTimeBudget();
+    for (int k = 0; k < 2; ++k) {
+      const auto f = testing::observe(cam, pts, T_w_k[static_cast<std::size_t>(k)].inverse(),
+                                      static_cast<std::uint64_t>(k), so);
+      EXPECT_TRUE(w.addFrame(f.sequence, f.time_ns, toWindow(f), guess).isOk());
+    }
+    auto s = w.solve();
+    EXPECT_TRUE(s) << s.status().toString();
+    return s ? *s : WindowSolveSummary{};
+  };
+  double applied = 0.0;
+  const WindowSolveSummary full = solveWith(0.5, &applied);
+  EXPECT_EQ(applied, 0.5);
+  EXPECT_TRUE(full.converged);
+  EXPECT_GT(full.iterations, 1);
+  const WindowSolveSummary starved = solveWith(1e-9, &applied);
+  EXPECT_EQ(applied, 1e-9);
+  EXPECT_FALSE(starved.converged);
+  EXPECT_LT(starved.iterations, full.iterations);
+  solveWith(5.0, &applied);  // above the configured limit: clamped
+  EXPECT_EQ(applied, 1.0);
+  solveWith(std::nan(""), &applied);  // not a budget: the configured limit
+  EXPECT_EQ(applied, 1.0);
+  solveWith(-1.0, &applied);
+  EXPECT_EQ(applied, 1.0);
+}
+
 }  // namespace
 }  // namespace sunvo::backend

@@ -6,6 +6,7 @@
 
 #include "sunvo/metrics/metrics.hpp"
 #include "sunvo/render/drive.hpp"
+#include "sunvo/sun_estimators/sun_estimators.hpp"
 
 namespace sunvo::replay {
 namespace {
@@ -54,6 +55,17 @@ TEST(Replay, RenderedDriveThroughTheWholeChain) {
   ASSERT_TRUE(ev_sun);
   EXPECT_LT(ev_sun->table1.rot_armse_rad, 2e-3);
   EXPECT_LT(ev_sun->table1.final_drift_m, 0.1);
+
+  // An image estimator inside the pipeline: Sun-CNN on the colour images of frames 5, 10, 15.
+  auto cnn = suneval::makeSunEstimator("sun_cnn");
+  ASSERT_TRUE(cnn) << cnn.status().toString();
+  auto image_sun = replayDrive(options, std::nullopt, cnn->get());
+  ASSERT_TRUE(image_sun) << image_sun.status().toString();
+  EXPECT_EQ(image_sun->name, "VO+Sun (sun_cnn)");
+  EXPECT_EQ(image_sun->sun_calls, 3);
+  ASSERT_EQ(image_sun->T_w_c.size(), 20u);
+  for (const Isometry3& T : image_sun->T_w_c) ASSERT_TRUE(T.matrix().allFinite());
+  EXPECT_FALSE(replayDrive(options, sources[0], cnn->get()));  // one source at a time
 
   // Deterministic replay.
   auto again = replayDrive(options, std::nullopt);

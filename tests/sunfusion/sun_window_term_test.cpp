@@ -58,6 +58,20 @@ class SunWindowTermTest : public ::testing::Test {
     return std::abs(logSO3(dC).y()) / kDeg;
   }
 
+  // Like solveAndYawError, for the frames (sequence - 1, sequence): a run of windows that all start
+  // from the same erroneous base, as a stream of frames would with a constant attitude error.
+  void solveAt(SunWindowTerm* term, std::uint64_t sequence, SunObservation obs) {
+    window_.reset(T_w_b_est_);
+    term->attach(window_);
+    obs.measurement.sequence = sequence;
+    term->addObservation(obs);
+    const TimeNs t = static_cast<TimeNs>(sequence) * 100'000'000;
+    ASSERT_TRUE(
+        window_.addFrame(sequence - 1, t - 100'000'000, obs_b_, Isometry3::Identity()).isOk());
+    ASSERT_TRUE(window_.addFrame(sequence, t, obs_k_, T_k_b_true_).isOk());
+    ASSERT_TRUE(window_.solve());
+  }
+
   SunObservation perfectObservation(SunMeasurementKind kind, double sigma) const {
     SunObservation o;
     o.sun_w = sun_w_;
@@ -198,6 +212,65 @@ TEST_F(SunWindowTermTest, BaseAttitudeModeWeighsAnImpreciseMeasurementAgainstThe
   const double err = solveAndYawError(&term, perfectObservation(SunMeasurementKind::kFull3d, 0.1));
   EXPECT_GT(err, 0.2);
   EXPECT_LT(err, 1.8);
+}
+
+TEST_F(SunWindowTermTest, InnovationGateRefusesAMeasurementTheConfidentFilterCannotExplain) {
+  // A 0.3 deg prior and a measurement 30 deg off in azimuth (inside the cosine gate: distance
+  // 1 - cos 30 deg = 0.13 < 0.3) with a 3 deg sigma: r^T S^-1 r is about 100, far above 16.3.
+  SunFusionOptions opt = baseAttitudeOptions();
+  opt.initial_attitude_sigma_deg = 0.3;
+  T_w_b_est_ = Isometry3::Identity();  // no base error: the measurement alone is wrong
+  SunObservation wrong = perfectObservation(SunMeasurementKind::kFull3d, 0.05);
+  wrong.measurement.sun_c =
+      expSO3(Eigen::Vector3d(0.0, 30.0 * kDeg, 0.0)) * wrong.measurement.sun_c;
+  SunWindowTerm gated;
+  ASSERT_TRUE(gated.init(opt).isOk());
+  const double err_gated = solveAndYawError(&gated, wrong);
+  EXPECT_EQ(gated.counters().rejected_innovation, 1u);
+  EXPECT_EQ(gated.counters().accepted, 0u);
+  EXPECT_EQ(gated.lastDecision(), GateResult::kRejectedInnovation);
+  EXPECT_LT(err_gated, 0.01);
+  // Without the innovation gate the same measurement is taken and drags the attitude.
+  opt.innovation_gate_chi2 = 0.0;
+  SunWindowTerm open;
+  ASSERT_TRUE(open.init(opt).isOk());
+  EXPECT_GT(solveAndYawError(&open, wrong), 0.1);
+  EXPECT_EQ(open.counters().accepted, 1u);
+}
+
+TEST_F(SunWindowTermTest, AdaptiveDriftRisesWhenInnovationsExceedTheFilterAndFallsOtherwise) {
+  // Every window starts from the same 2 deg base error. Precise measurements (0.57 deg) keep
+  // seeing an error that the shrinking covariance cannot explain: q_theta must rise. Imprecise
+  // ones (17 deg) see innovations well inside S: q_theta must fall.
+  SunFusionOptions opt = baseAttitudeOptions();
+  opt.innovation_gate_chi2 = 0.0;
+  opt.adaptive_drift = true;
+  opt.attitude_drift_deg_per_frame = 0.05;
+  SunWindowTerm precise, imprecise;
+  ASSERT_TRUE(precise.init(opt).isOk());
+  ASSERT_TRUE(imprecise.init(opt).isOk());
+  for (std::uint64_t k = 1; k <= 41; k += 2) {
+    solveAt(&precise, k, perfectObservation(SunMeasurementKind::kFull3d, 0.01));
+    solveAt(&imprecise, k, perfectObservation(SunMeasurementKind::kFull3d, 0.3));
+  }
+  EXPECT_GT(precise.driftDegPerFrame(), 0.2);
+  EXPECT_LT(imprecise.driftDegPerFrame(), 0.01);
+  EXPECT_GE(imprecise.driftDegPerFrame(), opt.min_drift_deg_per_frame);
+  EXPECT_LE(precise.driftDegPerFrame(), opt.max_drift_deg_per_frame);
+  EXPECT_TRUE(precise.attitudeCovariance().allFinite());
+}
+
+TEST(SunFusionOptionsTest, ValidationNamesTheBadKey) {
+  SunFusionOptions opt;
+  EXPECT_TRUE(opt.validate().isOk());
+  opt.min_drift_deg_per_frame = 1.0;  // above max
+  EXPECT_NE(opt.validate().toString().find("min_drift_deg_per_frame"), std::string::npos);
+  opt = SunFusionOptions{};
+  opt.drift_adaptation_rate = 0.0;
+  EXPECT_NE(opt.validate().toString().find("drift_adaptation_rate"), std::string::npos);
+  opt = SunFusionOptions{};
+  opt.innovation_gate_chi2 = -1.0;
+  EXPECT_NE(opt.validate().toString().find("innovation_gate_chi2"), std::string::npos);
 }
 
 }  // namespace

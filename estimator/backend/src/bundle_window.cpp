@@ -54,6 +54,7 @@ Status BundleWindow::init(const WindowOptions& options, const StereoCamera& came
   SUNVO_RETURN_IF_ERROR(camera.validate());
   problem_.reset();
   options_ = options;
+  time_budget_s_ = options.max_solver_time_in_seconds;
   camera_ = camera;
   model_.fu = camera.fu;
   model_.fv = camera.fv;
@@ -123,6 +124,12 @@ void BundleWindow::reset(const Isometry3& T_w_b) {
   T_w_b_ = T_w_b;
   size_ = 0;
   for (auto& p : poses_) p = PoseBlock{};
+}
+
+void BundleWindow::setSolverTimeBudget(double seconds) {
+  const double configured = options_.max_solver_time_in_seconds;
+  time_budget_s_ = std::isfinite(seconds) && seconds > 0.0 ? std::min(seconds, configured)
+                                                            : configured;
 }
 
 void BundleWindow::setPose(int slot, const Isometry3& T_k_b) {
@@ -347,7 +354,7 @@ Expected<WindowSolveSummary> BundleWindow::solve() {
   so.linear_solver_type = ceres::DENSE_SCHUR;
   so.num_threads = 1;
   so.max_num_iterations = options_.max_num_iterations;
-  so.max_solver_time_in_seconds = options_.max_solver_time_in_seconds;
+  so.max_solver_time_in_seconds = time_budget_s_;
   so.minimizer_progress_to_stdout = false;
   so.logging_type = ceres::SILENT;
   ceres::Solver::Summary summary;

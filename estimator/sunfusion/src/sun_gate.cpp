@@ -30,6 +30,8 @@ const char* toString(GateResult r) {
       return "rejected: sun below limit";
     case GateResult::kRejectedInvalid:
       return "rejected: invalid measurement";
+    case GateResult::kRejectedInnovation:
+      return "rejected: innovation";
   }
   return "unknown";
 }
@@ -50,6 +52,9 @@ void GateCounters::count(GateResult r) {
       break;
     case GateResult::kRejectedInvalid:
       ++rejected_invalid;
+      break;
+    case GateResult::kRejectedInnovation:
+      ++rejected_innovation;
       break;
   }
 }

@@ -1,7 +1,9 @@
 #include "sunvo/sunfusion/sun_window_term.hpp"
 
 #include <Eigen/Cholesky>
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "sunvo/core/geometry.hpp"
 #include "sunvo/sunfusion/sun_residual.hpp"
@@ -25,6 +27,17 @@ Status SunFusionOptions::validate() const {
   if (!(attitude_drift_deg_per_frame >= 0.0 && attitude_drift_deg_per_frame <= 5.0)) {
     return invalidArgument("sun_fusion.attitude_drift_deg_per_frame out of range [0, 5]");
   }
+  if (!(min_drift_deg_per_frame >= 0.0 && min_drift_deg_per_frame <= max_drift_deg_per_frame &&
+        max_drift_deg_per_frame <= 5.0)) {
+    return invalidArgument(
+        "sun_fusion.min_drift_deg_per_frame / max_drift_deg_per_frame: need 0 <= min <= max <= 5");
+  }
+  if (!(drift_adaptation_rate > 0.0 && drift_adaptation_rate <= 1.0)) {
+    return invalidArgument("sun_fusion.drift_adaptation_rate out of range (0, 1]");
+  }
+  if (!(innovation_gate_chi2 >= 0.0 && innovation_gate_chi2 <= 1e6)) {
+    return invalidArgument("sun_fusion.innovation_gate_chi2 out of range [0, 1e6]");
+  }
   return Status::ok();
 }
 
@@ -39,6 +52,7 @@ Status SunWindowTerm::init(const SunFusionOptions& options) {
   delta_ = {0.0, 0.0, 0.0};
   const double s0 = options.initial_attitude_sigma_deg * kDeg;
   P_ = Eigen::Matrix3d::Identity() * s0 * s0;
+  drift_deg_per_frame_ = options.attitude_drift_deg_per_frame;
   last_sequence_.reset();
   num_used_ = 0;
   return Status::ok();
@@ -58,17 +72,17 @@ void SunWindowTerm::addObservation(const SunObservation& observation) {
 
 Status SunWindowTerm::onSolve(backend::BundleWindow& window) {
   const bool estimate = options_.estimate_base_attitude;
-  // Grow the attitude uncertainty to the newest frame: a random walk per frame.
   const std::uint64_t newest = window.sequence(window.size() - 1);
-  if (last_sequence_ && newest > *last_sequence_) {
-    const double q = options_.attitude_drift_deg_per_frame * kDeg;
-    P_ += Eigen::Matrix3d::Identity() * q * q * static_cast<double>(newest - *last_sequence_);
+  if (estimate && last_sequence_ && newest > *last_sequence_) {
+    propagate(static_cast<double>(newest - *last_sequence_));
   }
   last_sequence_ = newest;
   delta_ = {0.0, 0.0, 0.0};
   num_used_ = 0;
 
+  // Prior of this solve's base correction delta_b = C_b_w dtheta_w: N(0, C_b_w P_theta C_w_b).
   const Eigen::Matrix3d C_b_w = window.T_w_b().linear().transpose();
+  const Eigen::Matrix3d P_b = C_b_w * P_ * C_b_w.transpose();
   for (int s = 1; s < window.size(); ++s) {
     const std::size_t ring = window.sequence(s) % pending_.size();
     if (!used_[ring] || pending_[ring].obs.measurement.sequence != window.sequence(s)) continue;
@@ -77,7 +91,16 @@ Status SunWindowTerm::onSolve(backend::BundleWindow& window) {
     if (!p.decided) {
       const Eigen::Vector3d predicted_c = window.T_k_b(s).linear() * sun_b;
       const double up = p.obs.sun_w.dot(options_.world_up);
-      const GateResult r = gateSunMeasurement(options_.gate, predicted_c, up, p.obs.measurement);
+      GateResult r = gateSunMeasurement(options_.gate, predicted_c, up, p.obs.measurement);
+      if (r == GateResult::kAccepted && estimate) {
+        int m = 0;
+        const double nis = innovationSq(window.T_k_b(s), sun_b, p.obs.measurement, P_b, &m);
+        if (options_.innovation_gate_chi2 > 0.0 && nis > options_.innovation_gate_chi2) {
+          r = GateResult::kRejectedInnovation;
+        } else if (options_.adaptive_drift && m > 0) {
+          adaptDrift(nis, m);
+        }
+      }
       counters_.count(r);
       last_decision_ = r;
       p.decided = true;
@@ -103,8 +126,8 @@ Status SunWindowTerm::onSolve(backend::BundleWindow& window) {
     }
   }
   if (estimate && num_used_ > 0) {
-    // Square-root information of the prior: L^T L = P^-1.
-    const Eigen::Matrix3d info = P_.inverse();
+    // Square-root information of the prior: L^T L = P_b^-1.
+    const Eigen::Matrix3d info = P_b.inverse();
     const Eigen::Matrix3d L = Eigen::LLT<Eigen::Matrix3d>(info).matrixU();
     prior_cost_.reset(AttitudePriorResidual::Create(L));
     double* extra[] = {delta_.data()};
@@ -115,8 +138,8 @@ Status SunWindowTerm::onSolve(backend::BundleWindow& window) {
 
 void SunWindowTerm::onSolved(backend::BundleWindow& window) {
   if (!options_.estimate_base_attitude || num_used_ == 0) return;
-  // Information of the sun residuals about delta at the solution.
-  Eigen::Matrix3d info = P_.inverse();
+  // Information of the sun residuals about delta_b at the solution.
+  Eigen::Matrix3d info_b = Eigen::Matrix3d::Zero();
   for (int i = 0; i < num_used_; ++i) {
     const Pending& p =
         pending_[static_cast<std::size_t>(used_in_solve_[static_cast<std::size_t>(i)])];
@@ -125,23 +148,79 @@ void SunWindowTerm::onSolved(backend::BundleWindow& window) {
       if (window.sequence(s) == p.obs.measurement.sequence) slot = s;
     }
     if (slot < 0 || !p.cost) continue;
-    const Eigen::Quaterniond q(window.T_k_b(slot).linear());
-    const int m = p.cost->num_residuals();
-    Eigen::Matrix<double, 3, 1> r;
-    Eigen::Matrix<double, 3, 4, Eigen::RowMajor> J_q;
     Eigen::Matrix<double, 3, 3, Eigen::RowMajor> J_d;
-    const double* params[] = {q.coeffs().data(), delta_.data()};
-    double* jacobians[] = {J_q.data(), J_d.data()};
-    if (!p.cost->Evaluate(params, r.data(), jacobians)) continue;
+    Eigen::Vector3d r;
+    int m = 0;
+    if (!evaluateAt(*p.cost, window.T_k_b(slot), delta_.data(), &r, &J_d, &m)) continue;
     const Eigen::MatrixXd J = J_d.topRows(m);
-    info += J.transpose() * J;
+    info_b += J.transpose() * J;
   }
-  const Eigen::Vector3d delta(delta_[0], delta_[1], delta_[2]);
-  if (delta.allFinite()) window.correctBaseAttitude(expSO3(delta));
-  const Eigen::Matrix3d P_new = info.inverse();
-  if (P_new.allFinite()) P_ = 0.5 * (P_new + P_new.transpose());
+  const Eigen::Vector3d delta_b(delta_[0], delta_[1], delta_[2]);
   delta_ = {0.0, 0.0, 0.0};
   num_used_ = 0;
+  if (!delta_b.allFinite() || !info_b.allFinite()) return;
+  const Eigen::Matrix3d C_w_b = window.T_w_b().linear();
+  const Eigen::Matrix3d A = C_w_b * info_b * C_w_b.transpose();  // information about dtheta_w
+
+  // P <- (P^-1 + A)^-1, written as P - P (I + A P)^-1 A P: no inverse of a singular A (an
+  // azimuth-only measurement informs one or two axes only).
+  const Eigen::Matrix3d M = (Eigen::Matrix3d::Identity() + A * P_).inverse() * A;
+  Eigen::Matrix3d P_new = P_ - P_ * M * P_;
+  P_new = 0.5 * (P_new + P_new.transpose());
+  if (!P_new.allFinite()) return;
+  P_ = P_new;
+  window.correctBaseAttitude(expSO3(delta_b));
+}
+
+void SunWindowTerm::propagate(double frames) {
+  const double q = drift_deg_per_frame_ * kDeg;
+  P_ += Eigen::Matrix3d::Identity() * q * q * frames;
+}
+
+bool SunWindowTerm::evaluateAt(const ceres::CostFunction& cost, const Isometry3& T_k_b,
+                               const double* delta_b, Eigen::Vector3d* r,
+                               Eigen::Matrix<double, 3, 3, Eigen::RowMajor>* J_d, int* m) {
+  const Eigen::Quaterniond q(T_k_b.linear());
+  Eigen::Matrix<double, 3, 4, Eigen::RowMajor> J_q;
+  const double* params[] = {q.coeffs().data(), delta_b};
+  double* jacobians[] = {J_q.data(), J_d->data()};
+  *m = cost.num_residuals();
+  return cost.Evaluate(params, r->data(), jacobians) && r->head(*m).allFinite() &&
+         J_d->topRows(*m).allFinite();
+}
+
+void SunWindowTerm::adaptDrift(double nis, int dof) {
+  // Robust innovation-based adaptation (a stochastic approximation of the median): with a
+  // consistent filter the NIS is chi-square with `dof` degrees of freedom and exceeds its median
+  // half of the time. q_theta is raised by a log-step when the NIS is above that median and
+  // lowered when below, so it settles where the innovations are consistent; an outlier moves it
+  // by one step only, whatever its size.
+  const double median = dof <= 1 ? 0.455 : (dof == 2 ? 1.386 : 2.366);
+  const double step =
+      nis > median ? options_.drift_adaptation_rate : -options_.drift_adaptation_rate;
+  drift_deg_per_frame_ *= std::exp(step);
+  drift_deg_per_frame_ = std::clamp(drift_deg_per_frame_, options_.min_drift_deg_per_frame,
+                                    options_.max_drift_deg_per_frame);
+}
+
+double SunWindowTerm::innovationSq(const Isometry3& T_k_b, const Eigen::Vector3d& sun_b,
+                                   const SunMeasurement& m, const Eigen::Matrix3d& P_b,
+                                   int* dof) const {
+  const bool azimuth = m.kind == SunMeasurementKind::kAzimuthOnly;
+  const std::unique_ptr<ceres::CostFunction> cost(
+      azimuth ? SunAzimuthResidual::CreateWithBaseCorrection(sun_b, xzDirection(m.sun_c), m.sigma)
+              : SunDirectionResidual::CreateWithBaseCorrection(sun_b, m.sun_c, m.sigma));
+  const double zero[3] = {0.0, 0.0, 0.0};
+  Eigen::Vector3d r;
+  Eigen::Matrix<double, 3, 3, Eigen::RowMajor> J_d;
+  int n = 0;
+  *dof = 0;
+  if (!evaluateAt(*cost, T_k_b, zero, &r, &J_d, &n)) return std::numeric_limits<double>::infinity();
+  *dof = n;
+  const Eigen::MatrixXd J = J_d.topRows(n);
+  const Eigen::MatrixXd S = J * P_b * J.transpose() + Eigen::MatrixXd::Identity(n, n);
+  const Eigen::VectorXd rn = r.head(n);
+  return rn.dot(S.ldlt().solve(rn));
 }
 
 }  // namespace sunvo::sunfusion

@@ -20,8 +20,11 @@ namespace {
 
 std::atomic<std::uint64_t> g_count{0};
 std::atomic<std::uint64_t> g_bytes{0};
+// Per thread: a constant-initialised thread_local (static TLS, no allocation on first use).
+thread_local std::uint64_t t_count = 0;
 
 inline void record(std::size_t bytes) {
+  ++t_count;
   g_count.fetch_add(1, std::memory_order_relaxed);
   g_bytes.fetch_add(bytes, std::memory_order_relaxed);
 }
@@ -177,6 +180,9 @@ namespace sunvo::bench {
 
 std::uint64_t allocationCount() {
   return g_count.load(std::memory_order_relaxed);
+}
+std::uint64_t threadAllocationCount() {
+  return t_count;
 }
 std::uint64_t allocatedBytes() {
   return g_bytes.load(std::memory_order_relaxed);

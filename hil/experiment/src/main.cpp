@@ -5,9 +5,16 @@
 //
 // Usage: sunvo_experiment [--data DIR] [--out DIR] [--routes 0020,00,06] [--frames N]
 //                         [--every N] [--seed N] [--drift-deg D] [--sun-loss S] [--paper-form]
-//   --drift-deg   attitude random walk of VO per frame for the sun fusion (deg)
+//                         [--write-poses] [--fixed-drift]
+//                         [--innovation-gate X]
+//   --drift-deg   attitude random walk of VO per frame for the sun fusion (deg; the start value
+//                 when it adapts)
 //   --sun-loss    Cauchy scale on the whitened sun residual (0 = none)
 //   --paper-form  hold the base attitude fixed, as the paper did
+//   --fixed-drift keep the attitude random walk at --drift-deg instead of adapting it
+//   --innovation-gate  chi-square bound of the innovation gate (0 = off)
+//   --write-poses also write every run's poses and the ground truth as KITTI pose files
+//                 (route_<id>_gt.txt, route_<id>_run<i>.txt; run 0 is pure VO, then the sources)
 
 #include <cstdio>
 #include <cstdlib>
@@ -27,10 +34,10 @@ using sunvo::experiment::RunResult;
 
 int usage(const std::string& msg) {
   std::fprintf(stderr, "sunvo_experiment: %s\n", msg.c_str());
-  std::fprintf(
-      stderr,
-      "usage: sunvo_experiment [--data DIR] [--out DIR] [--routes 0020,00,06] "
-      "[--frames N] [--every N] [--seed N] [--drift-deg D] [--sun-loss S] [--paper-form]\n");
+  std::fprintf(stderr,
+               "usage: sunvo_experiment [--data DIR] [--out DIR] [--routes 0020,00,06] "
+               "[--frames N] [--every N] [--seed N] [--drift-deg D] [--sun-loss S] [--paper-form] "
+               "[--write-poses] [--fixed-drift] [--innovation-gate X]\n");
   return 2;
 }
 
@@ -65,6 +72,9 @@ int main(int argc, char** argv) {
   int frames = 0, every = 5, seed = 1;
   double drift_deg = -1.0, sun_loss = -1.0;
   bool paper_form = false;
+  bool write_poses = false;
+  bool fixed_drift = false;
+  double innovation_gate = -1.0;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     const bool has_value = i + 1 < argc;
@@ -87,6 +97,12 @@ int main(int argc, char** argv) {
       sun_loss = std::strtod(argv[++i], nullptr);
     } else if (a == "--paper-form") {
       paper_form = true;
+    } else if (a == "--write-poses") {
+      write_poses = true;
+    } else if (a == "--fixed-drift") {
+      fixed_drift = true;
+    } else if (a == "--innovation-gate" && has_value) {
+      innovation_gate = std::strtod(argv[++i], nullptr);
     } else if (a == "--seed" && has_value) {
       if (!parseInt(argv[++i], seed)) return usage("--seed needs a number >= 0");
     } else {
@@ -106,6 +122,8 @@ int main(int argc, char** argv) {
   if (drift_deg >= 0.0) options.fusion.attitude_drift_deg_per_frame = drift_deg;
   if (sun_loss >= 0.0) options.fusion.loss_scale = sun_loss;
   options.fusion.estimate_base_attitude = !paper_form;
+  if (fixed_drift) options.fusion.adaptive_drift = false;
+  if (innovation_gate >= 0.0) options.fusion.innovation_gate_chi2 = innovation_gate;
   if (auto s = options.validate(); !s.isOk()) return usage(s.toString());
   const auto sources = sunvo::experiment::defaultSunSources(static_cast<std::uint32_t>(seed));
 
@@ -152,6 +170,20 @@ int main(int argc, char** argv) {
     const std::vector<sunvo::Isometry3> gt(
         route->T_w_c_gt.begin(),
         route->T_w_c_gt.begin() + static_cast<std::ptrdiff_t>(input.num_poses));
+    if (write_poses) {
+      const auto write = [&](const std::string& name, const std::vector<sunvo::Isometry3>& T) {
+        sunvo::files::Trajectory t;
+        t.T_w_c = T;
+        t.t_ns.resize(T.size());
+        return sunvo::files::writeKittiPoses(out_dir + "/route_" + id + "_" + name + ".txt", t);
+      };
+      if (auto s = write("gt", gt); !s.isOk()) return usage(s.toString());
+      for (std::size_t i = 0; i < runs.size(); ++i) {
+        if (auto s = write("run" + std::to_string(i), runs[i].T_w_c); !s.isOk()) {
+          return usage(s.toString());
+        }
+      }
+    }
     auto table = sunvo::report::writeRouteReport(out_dir + "/route_" + id, input, gt, series);
     if (!table) return usage(table.status().toString());
     std::printf("\n### %s (%zu frames, %.0f m)\n\n%s", route->name.c_str(), input.num_poses,

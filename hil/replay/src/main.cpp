@@ -4,11 +4,12 @@
 // top-view plot.
 //
 // Usage: sunvo_replay --drive DIR [--out DIR] [--frames N] [--every N] [--seed N]
-//                     [--drift-deg D] [--paper-form] [--poses]
-//
-// --poses also writes each run's estimated T_w_c as a KITTI pose file,
-// OUT/replay_poses_<run>.txt (run: pure_vo, vo_sun_true_vector, ...), for comparing replays
-// across builds (scripts/test_arm64.sh compares x86-64 with aarch64).
+//                     [--drift-deg D] [--paper-form] [--estimators a,b,...] [--poses]
+//   --estimators  also VO + sun from these image estimators (lalonde, lalonde_vo, sun_cnn) run
+//                 on the drive's colour images; "none" (default) runs the error-model sources
+//   --poses       also writes each run's estimated T_w_c as a KITTI pose file,
+//                 OUT/replay_poses_<run>.txt (run: pure_vo, vo_sun_true_vector, ...), for
+//                 comparing replays across builds (scripts/test_arm64.sh: x86-64 vs aarch64)
 
 #include <cctype>
 #include <cstdio>
@@ -21,6 +22,7 @@
 #include "sunvo/metrics/metrics.hpp"
 #include "sunvo/replay/replay.hpp"
 #include "sunvo/report/report_files.hpp"
+#include "sunvo/sun_estimators/sun_estimators.hpp"
 
 namespace {
 
@@ -28,7 +30,7 @@ int usage(const std::string& msg) {
   std::fprintf(stderr, "sunvo_replay: %s\n", msg.c_str());
   std::fprintf(stderr,
                "usage: sunvo_replay --drive DIR [--out DIR] [--frames N] [--every N] [--seed N] "
-               "[--drift-deg D] [--paper-form] [--poses]\n");
+               "[--drift-deg D] [--paper-form] [--estimators a,b,...] [--poses]\n");
   return 2;
 }
 
@@ -62,6 +64,7 @@ int main(int argc, char** argv) {
   std::string out_dir = "replay_out";
   int seed = 1;
   bool write_poses = false;
+  std::vector<std::string> estimator_names;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     const bool has_value = i + 1 < argc;
@@ -81,6 +84,14 @@ int main(int argc, char** argv) {
       options.fusion.estimate_base_attitude = false;
     } else if (a == "--poses") {
       write_poses = true;
+    } else if (a == "--estimators" && has_value) {
+      std::string list = argv[++i];
+      for (std::size_t p = 0; p <= list.size();) {
+        const std::size_t q = std::min(list.find(',', p), list.size());
+        if (q > p && list.substr(p, q - p) != "none")
+          estimator_names.push_back(list.substr(p, q - p));
+        p = q + 1;
+      }
     } else {
       return usage("unknown or incomplete argument '" + a + "'");
     }
@@ -102,8 +113,14 @@ int main(int argc, char** argv) {
   input.plane = sunvo::metrics::HorizontalPlane::kEastNorth;
   std::vector<sunvo::report::PlotSeries> series;
   std::vector<sunvo::Isometry3> gt;
-  for (const auto& spec : specs) {
-    auto run = sunvo::replay::replayDrive(options, spec);
+  auto estimators = sunvo::suneval::makeSunEstimators(estimator_names);
+  if (!estimators) return usage(estimators.status().toString());
+  const std::size_t num_runs = specs.size() + estimators->size();
+  for (std::size_t i = 0; i < num_runs; ++i) {
+    const bool image = i >= specs.size();
+    auto run = image ? sunvo::replay::replayDrive(options, std::nullopt,
+                                                  (*estimators)[i - specs.size()].get())
+                     : sunvo::replay::replayDrive(options, specs[i]);
     if (!run) {
       std::fprintf(stderr, "sunvo_replay: %s\n", run.status().toString().c_str());
       return 1;
@@ -119,6 +136,11 @@ int main(int argc, char** argv) {
                  run->name.c_str(), run->T_w_c.size(), run->median_ms, run->p99_ms,
                  run->lost_frames, static_cast<unsigned long long>(run->gate.accepted),
                  static_cast<unsigned long long>(run->gate.total()));
+    if (run->sun_calls > 0) {
+      std::fprintf(stderr, "  %-28s %d estimator calls, %.1f ms median, %.1f ms p90\n", "",
+                   run->sun_calls, sunvo::metrics::percentile(run->sun_ms, 0.5),
+                   sunvo::metrics::percentile(run->sun_ms, 0.9));
+    }
     if (write_poses) {
       const std::string path = out_dir + "/replay_poses_" + fileSlug(run->name) + ".txt";
       sunvo::files::Trajectory trajectory;
@@ -136,9 +158,10 @@ int main(int argc, char** argv) {
   if (!table) return usage(table.status().toString());
   std::printf(
       "\n### Replay of %s (%zu frames, %.0f m; sun measurements from the ground truth "
-      "through error models)\n\n%s",
+      "through error models%s)\n\n%s",
       options.drive_dir.c_str(), input.num_poses,
-      input.estimates.front().evaluation.table1.gt_path_length_m, table->c_str());
+      input.estimates.front().evaluation.table1.gt_path_length_m,
+      estimators->empty() ? "" : " and from the image estimators", table->c_str());
   std::printf("\nwrote %s/replay_{table1.md,metrics.json,topview.png}\n", out_dir.c_str());
   return 0;
 }

@@ -73,13 +73,18 @@ Expected<ReplayData> loadReplayData(const ReplayOptions& options) {
 }
 
 Expected<ReplayRun> replayDrive(const ReplayOptions& options,
-                                const std::optional<experiment::SunSourceSpec>& spec) {
+                                const std::optional<experiment::SunSourceSpec>& spec,
+                                sunfusion::ImageSunEstimator* image_sun) {
+  if (spec && image_sun != nullptr) {
+    return invalidArgument("replayDrive: give an error-model sun source or an image estimator");
+  }
   SUNVO_RETURN_IF_ERROR(options.validate());
   kitti::KittiSourceOptions src_opt;
   src_opt.root = options.drive_dir;
   src_opt.layout = kitti::KittiLayout::kRaw;
   src_opt.utc_offset_s = options.utc_offset_s;
   if (options.max_frames > 0) src_opt.last_frame = options.max_frames - 1;
+  src_opt.use_color = image_sun != nullptr;
   auto source = kitti::KittiStereoSource::open(src_opt);
   if (!source) return source.status();
 
@@ -109,6 +114,17 @@ Expected<ReplayRun> replayDrive(const ReplayOptions& options,
   sunfusion::SunWindowTerm sun_term;
   std::optional<sunfusion::SimulatedSunSource> sun_source;
   std::vector<Eigen::Vector3d> sun_c_gt;
+  if (image_sun != nullptr) {
+    if (!source->colorCamera()) {
+      return notFound(options.drive_dir + ": the image sun estimators need the colour images");
+    }
+    sunfusion::SunFusionOptions fusion = options.fusion;
+    fusion.world_up = Eigen::Vector3d::UnitZ();  // ENU
+    // Azimuth-only estimators are gated in the x-z plane, as the error-model Sun-CNN source.
+    if (std::string(image_sun->name()) == "sun_cnn") fusion.gate.plane = sunfusion::GatePlane::kXZ;
+    SUNVO_RETURN_IF_ERROR(sun_term.init(fusion));
+    sun_term.attach(vo.odometry().window());
+  }
   if (spec) {
     auto sun_csv = files::readSunCsv(options.drive_dir + "/gt/sun_cam0.csv");
     if (!sun_csv) return sun_csv.status();
@@ -122,15 +138,20 @@ Expected<ReplayRun> replayDrive(const ReplayOptions& options,
   }
 
   ReplayRun run;
-  run.name = spec ? spec->name : "Pure VO";
+  run.name = spec                   ? spec->name
+             : image_sun != nullptr ? "VO+Sun (" + std::string(image_sun->name()) + ")"
+                                    : "Pure VO";
+  Isometry3 T_w_c_last = T_w_c0;
   StereoFrame frame;
   std::vector<double> ms;
   for (std::size_t k = 0; !source->finished(); ++k) {
     const Status s = source->next(frame);
     if (source->finished()) break;
     SUNVO_RETURN_IF_ERROR(s);
-    if (sun_source && k > 0 && k % static_cast<std::size_t>(options.every_n_frames) == 0 &&
-        k < oxts->size() && k < sun_c_gt.size()) {
+    const bool sun_frame = (sun_source || image_sun != nullptr) && k > 0 &&
+                           k % static_cast<std::size_t>(options.every_n_frames) == 0 &&
+                           k < oxts->size();
+    if (sun_frame) {
       // The sun in the world from the ephemeris at this frame's GPS fix and UTC time.
       const kitti::OxtsRecord& fix = (*oxts)[k].record;
       sun::SpaOptions spa;
@@ -139,14 +160,34 @@ Expected<ReplayRun> replayDrive(const ReplayOptions& options,
       spa.elevation_m = fix.alt;
       auto sp = sun::computeSolarPosition(frame.trigger_time_ns, spa);
       if (!sp) return sp.status();
-      auto m = sun_source->measure(frame.sequence, frame.trigger_time_ns, sun_c_gt[k]);
-      if (m) sun_term.addObservation({*m, sp->sun_enu});
+      if (sun_source && k < sun_c_gt.size()) {
+        auto m = sun_source->measure(frame.sequence, frame.trigger_time_ns, sun_c_gt[k]);
+        if (m) sun_term.addObservation({*m, sp->sun_enu});
+      } else if (image_sun != nullptr) {
+        // The prior from the last VO pose (Lalonde-VO); the colour camera is rectified to the
+        // orientation of camera 0, so a direction in one is the same in the other.
+        const Eigen::Matrix3d C_c_w = T_w_c_last.linear().transpose();
+        sunfusion::ImageSunInput in{
+            frame.left_color, *source->colorCamera(),
+            sunfusion::SunPrior{C_c_w * sp->sun_enu, C_c_w * Eigen::Vector3d::UnitZ()}};
+        auto e = image_sun->estimate(in);
+        if (!e) return e.status();
+        ++run.sun_calls;
+        run.sun_ms.push_back(e->time_ms);
+        if (e->valid) {
+          sunfusion::SunMeasurement m = e->measurement;
+          m.sequence = frame.sequence;
+          m.time_ns = frame.trigger_time_ns;
+          sun_term.addObservation({m, sp->sun_enu});
+        }
+      }
     }
     auto r = vo.process(frame);
     if (!r) return r.status();
     if (r->vo.status == vo::TrackingStatus::kLost) ++run.lost_frames;
     ms.push_back(r->times.total_ms);
     run.T_w_c.push_back(r->vo.T_w_c);
+    T_w_c_last = r->vo.T_w_c;
   }
   run.gate = sun_term.counters();
   run.median_ms = metrics::percentile(ms, 0.5);

@@ -141,6 +141,12 @@ class BundleWindow {
 
   const WindowOptions& options() const { return options_; }
 
+  // Time limit of the following solves, s: a real-time caller shrinks it when a frame is late.
+  // Clamped to (0, options.max_solver_time_in_seconds]; a non-finite or non-positive value
+  // restores the configured limit. init() also restores it.
+  void setSolverTimeBudget(double seconds);
+  double solverTimeBudget() const { return time_budget_s_; }
+
  private:
   struct Frame {
     std::uint64_t sequence = 0;
@@ -164,6 +170,7 @@ class BundleWindow {
   void clearResiduals();
 
   WindowOptions options_;
+  double time_budget_s_ = 0.0;  // limit of the next solve, (0, options_.max_solver_time_in_seconds]
   StereoCamera camera_;
   StereoModel model_;
   bool initialized_ = false;

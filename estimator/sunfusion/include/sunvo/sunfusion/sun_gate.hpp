@@ -34,6 +34,7 @@ enum class GateResult {
   kRejectedVertical,
   kRejectedSunDown,
   kRejectedInvalid,
+  kRejectedInnovation,  // by the fusion's innovation gate (sun_window_term.hpp), not by this gate
 };
 
 const char* toString(GateResult r);
@@ -44,9 +45,11 @@ struct GateCounters {
   std::uint64_t rejected_vertical = 0;
   std::uint64_t rejected_sun_down = 0;
   std::uint64_t rejected_invalid = 0;
+  std::uint64_t rejected_innovation = 0;
   void count(GateResult r);
   std::uint64_t total() const {
-    return accepted + rejected_cosine + rejected_vertical + rejected_sun_down + rejected_invalid;
+    return accepted + rejected_cosine + rejected_vertical + rejected_sun_down + rejected_invalid +
+           rejected_innovation;
   }
 };
 

@@ -12,7 +12,9 @@ namespace sunvo::bench {
 
 // Allocation calls (malloc, calloc, realloc, the aligned forms, operator new) since start.
 std::uint64_t allocationCount();
-// Bytes requested by those calls.
+// Allocation calls made by the calling thread since it started.
+std::uint64_t threadAllocationCount();
+// Bytes requested by those calls (all threads).
 std::uint64_t allocatedBytes();
 // True when this executable's malloc is the counting one (checked by a real malloc call).
 bool allocCounterActive();

@@ -17,6 +17,7 @@
 #include "sunvo/experiment/experiment.hpp"
 #include "sunvo/geodesy/local_enu.hpp"
 #include "sunvo/pipeline/stereo_visual_odometry.hpp"
+#include "sunvo/sunfusion/image_sun_estimator.hpp"
 
 namespace sunvo::replay {
 
@@ -37,6 +38,8 @@ struct ReplayRun {
   int lost_frames = 0;
   double median_ms = 0.0;  // pipeline time per frame
   double p99_ms = 0.0;
+  int sun_calls = 0;           // image estimator calls (every n-th frame)
+  std::vector<double> sun_ms;  // their wall times, ms
 };
 
 struct ReplayData {
@@ -49,8 +52,11 @@ struct ReplayData {
 // moved into the world of the replay; image_00/timestamps.txt; the first OXTS fix).
 Expected<ReplayData> loadReplayData(const ReplayOptions& options);
 
-// One run: pure VO (spec == nullopt) or VO + sun from one source.
+// One run: pure VO (no spec, no estimator), VO + sun from one error-model source (spec), or
+// VO + sun from an image estimator run on the left colour image every n-th frame, with the prior
+// from the last VO pose and the ephemeris (image_sun; not both).
 Expected<ReplayRun> replayDrive(const ReplayOptions& options,
-                                const std::optional<experiment::SunSourceSpec>& spec);
+                                const std::optional<experiment::SunSourceSpec>& spec,
+                                sunfusion::ImageSunEstimator* image_sun = nullptr);
 
 }  // namespace sunvo::replay

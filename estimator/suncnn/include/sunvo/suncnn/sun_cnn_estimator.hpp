@@ -1,0 +1,112 @@
+#pragma once
+// Sun-CNN: the sun's azimuth in the camera x-z plane from one colour image, with a per-image
+// uncertainty from Monte-Carlo dropout (after Ma, Kelly et al.'s Sun-CNN and Peretroukhin's
+// Sun-BCNN). The network is trained by estimator/suncnn/training/sun_cnn_train.py and shipped as
+// config/sun_cnn.onnx (+ sun_cnn.json, whose numbers the defaults below repeat).
+//
+// The ONNX graph has three inputs and one output:
+//   image [1, 3, H, W]  BGR, (pixel / 255 - pixel_mean) / pixel_std, resized with INTER_AREA
+//   mask1 [K, F], mask2 [K, D]  inverted-dropout masks of the two fully connected layers
+//                              (entries 0 or 1 / (1 - p); a row of ones = dropout off)
+//   azimuth_cs [K, 2]           row k: (c, s) ~ (cos az, sin az), az = atan2(sun_x, sun_z)
+// The convolutional trunk runs once, the head K times (one row per mask pair), so N MC samples
+// cost one forward pass. This class draws the masks itself (seeded, reproducible): row 0 is all
+// ones (the deterministic answer), rows 1..N are dropout samples, the rest are unused.
+//
+// Uncertainty. Two mean resultant lengths in [0, 1], turned into circular standard deviations
+// sqrt(-2 ln R) and added in quadrature:
+//   R_mc = |mean of the N unit sample directions|  (model uncertainty, MC dropout spread)
+//   R_al = |deterministic output (c, s)|            (data ambiguity: the net is trained with the
+//          squared chord loss, whose minimiser is E[(cos az, sin az) | image], so an image with
+//          no sun cue -- black, flat, noise -- is answered with a short vector)
+//   sigma = clamp(sigma_scale * sqrt(-2 ln R_mc - 2 ln R_al), sigma_min_rad, sigma_max_rad)
+// sigma_scale is fitted on held-out renders (median |error| / sigma = 0.674, as for a Gaussian).
+//
+// The library opens no file but the model, and only when init() is given a path.
+
+#include <cstdint>
+#include <opencv2/core/mat.hpp>
+#include <opencv2/dnn/dnn.hpp>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "sunvo/core/status.hpp"
+#include "sunvo/sunfusion/image_sun_estimator.hpp"
+
+namespace sunvo::suncnn {
+
+struct SunCnnOptions {
+  int input_width = 208;        // network input width, px, must match the model, [16, 2048]
+  int input_height = 64;        // network input height, px, must match the model, [16, 2048]
+  double pixel_mean = 0.5;      // input normalisation (pixel / 255 - mean) / std, [0, 1]
+  double pixel_std = 0.25;      // (0, 10]
+  int mask_rows = 32;           // K, rows of the exported head, must match the model, [2, 1024]
+  int mask1_size = 768;         // F, features into the first FC layer, must match, [1, 1e6]
+  int mask2_size = 128;         // D, hidden units into the second FC layer, must match, [1, 1e6]
+  double dropout_p = 0.3;       // dropout probability used in training, [0, 0.9]
+  int mc_samples = 16;          // N, MC dropout samples per image, [0, mask_rows - 1]; 0: R_mc = 1
+  double sigma_scale = 0.3477;  // calibration factor on the spread sigma, (0, 100]; fitted
+                                // on the held-out renders (config/sun_cnn.json)
+  double sigma_min_rad = 0.03;  // floor of the reported sigma, rad, [0, 1]
+  double sigma_max_rad = 3.0;   // cap of the reported sigma, rad, [sigma_min_rad, 10]
+  double max_valid_sigma_rad = 0.5;  // above this the estimate is returned with valid = false,
+                                     // rad, (0, 10]
+  double max_up_tilt_deg = 30.0;     // valid = false when the prior's "up" is further than this
+                                     // from the camera's -y (the azimuth is in the x-z plane), deg,
+                                     // [0, 90]; ignored without a prior
+  std::uint64_t seed = 1;            // RNG of the dropout masks
+  Status validate() const;           // names the bad key ("suncnn.mc_samples ...")
+};
+
+// The raw network answer for one image, before the uncertainty is turned into a measurement.
+struct SunCnnRaw {
+  double c = 0.0, s = 0.0;  // deterministic output (dropout off)
+  double r_mc = 1.0;        // mean resultant length of the MC sample directions, [0, 1]
+  double r_al = 0.0;        // length of the deterministic output, clamped to [0, 1]
+  double sigma_rad = 0.0;   // after scale and clamp
+};
+
+class SunCnnEstimator : public sunfusion::ImageSunEstimator {
+ public:
+  SunCnnEstimator() = default;
+  SunCnnEstimator(const SunCnnEstimator&) = delete;
+  SunCnnEstimator& operator=(const SunCnnEstimator&) = delete;
+
+  // Loads the model from an ONNX file or from its bytes, allocates the buffers and checks the
+  // model's shapes against the options with one forward pass. Errors name the option or file.
+  Status init(const SunCnnOptions& options, const std::string& model_path);
+  Status init(const SunCnnOptions& options, const std::vector<unsigned char>& model_bytes);
+
+  const char* name() const override { return "sun_cnn"; }
+
+  // Azimuth-only estimate: sun_c = (sin az, 0, cos az), sigma from the MC spread (see above).
+  // zenith_deg is 90 (the vector lies in the x-z plane), confidence = R_mc * R_al.
+  // Errors: not initialised; empty image or not CV_8UC3; image size != camera size (when the
+  // camera's size is set); image smaller than the network input.
+  Expected<sunfusion::ImageSunEstimate> estimate(const sunfusion::ImageSunInput& input) override;
+
+  // The network alone on a prepared input blob [1, 3, H, W] (CV_32F) and masks [K, F], [K, D]:
+  // the [K, 2] output. For the parity test against PyTorch.
+  Expected<cv::Mat> forwardRaw(const cv::Mat& blob, const cv::Mat& mask1, const cv::Mat& mask2);
+
+  // The last call's raw numbers (for evaluation tools).
+  const SunCnnRaw& lastRaw() const { return raw_; }
+  bool initialised() const { return ready_; }
+
+ private:
+  Status finishInit();
+  void fillMasks();
+
+  SunCnnOptions options_;
+  cv::dnn::Net net_;
+  bool ready_ = false;
+  std::mt19937_64 rng_;
+  cv::Mat small_;  // input_height x input_width, CV_8UC3
+  cv::Mat blob_;   // [1, 3, H, W] CV_32F
+  cv::Mat mask1_, mask2_, out_;
+  std::vector<cv::Mat> outs_;
+  SunCnnRaw raw_;
+};
+
+}  // namespace sunvo::suncnn

@@ -1,0 +1,220 @@
+#include "sunvo/suncnn/sun_cnn_estimator.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+namespace sunvo::suncnn {
+namespace {
+constexpr double kRadToDeg = 180.0 / std::numbers::pi;
+
+Status range(const char* key, const char* r) {
+  return invalidArgument(std::string("suncnn.") + key + " out of range " + r);
+}
+
+// Square of the circular standard deviation of a mean resultant length R in (0, 1]: -2 ln R.
+double circularStdSquared(double r) {
+  return -2.0 * std::log(std::clamp(r, 1e-6, 1.0));
+}
+}  // namespace
+
+Status SunCnnOptions::validate() const {
+  if (!(input_width >= 16 && input_width <= 2048)) return range("input_width", "[16, 2048]");
+  if (!(input_height >= 16 && input_height <= 2048)) return range("input_height", "[16, 2048]");
+  if (!(pixel_mean >= 0.0 && pixel_mean <= 1.0)) return range("pixel_mean", "[0, 1]");
+  if (!(pixel_std > 0.0 && pixel_std <= 10.0)) return range("pixel_std", "(0, 10]");
+  if (!(mask_rows >= 2 && mask_rows <= 1024)) return range("mask_rows", "[2, 1024]");
+  if (!(mask1_size >= 1 && mask1_size <= 1000000)) return range("mask1_size", "[1, 1e6]");
+  if (!(mask2_size >= 1 && mask2_size <= 1000000)) return range("mask2_size", "[1, 1e6]");
+  if (!(dropout_p >= 0.0 && dropout_p <= 0.9)) return range("dropout_p", "[0, 0.9]");
+  if (!(mc_samples >= 0 && mc_samples <= mask_rows - 1))
+    return range("mc_samples", "[0, mask_rows - 1]");
+  if (!(sigma_scale > 0.0 && sigma_scale <= 100.0)) return range("sigma_scale", "(0, 100]");
+  if (!(sigma_min_rad >= 0.0 && sigma_min_rad <= 1.0)) return range("sigma_min_rad", "[0, 1]");
+  if (!(sigma_max_rad >= sigma_min_rad && sigma_max_rad <= 10.0))
+    return range("sigma_max_rad", "[sigma_min_rad, 10]");
+  if (!(max_valid_sigma_rad > 0.0 && max_valid_sigma_rad <= 10.0))
+    return range("max_valid_sigma_rad", "(0, 10]");
+  if (!(max_up_tilt_deg >= 0.0 && max_up_tilt_deg <= 90.0))
+    return range("max_up_tilt_deg", "[0, 90]");
+  return Status::ok();
+}
+
+Status SunCnnEstimator::init(const SunCnnOptions& options, const std::string& model_path) {
+  ready_ = false;
+  SUNVO_RETURN_IF_ERROR(options.validate());
+  options_ = options;
+  try {
+    net_ = cv::dnn::readNetFromONNX(model_path);
+  } catch (const cv::Exception& e) {
+    return invalidArgument("suncnn: cannot read ONNX model " + model_path + ": " + e.msg);
+  }
+  if (net_.empty()) return invalidArgument("suncnn: empty ONNX model " + model_path);
+  return finishInit();
+}
+
+Status SunCnnEstimator::init(const SunCnnOptions& options,
+                             const std::vector<unsigned char>& model_bytes) {
+  ready_ = false;
+  SUNVO_RETURN_IF_ERROR(options.validate());
+  options_ = options;
+  if (model_bytes.empty()) return invalidArgument("suncnn: empty model bytes");
+  try {
+    net_ = cv::dnn::readNetFromONNX(model_bytes);
+  } catch (const cv::Exception& e) {
+    return invalidArgument(std::string("suncnn: cannot parse ONNX model bytes: ") + e.msg);
+  }
+  if (net_.empty()) return invalidArgument("suncnn: empty ONNX model (bytes)");
+  return finishInit();
+}
+
+Status SunCnnEstimator::finishInit() {
+  const SunCnnOptions& o = options_;
+  net_.setPreferableBackend(cv::dnn::DNN_BACKEND_OPENCV);
+  net_.setPreferableTarget(cv::dnn::DNN_TARGET_CPU);
+  rng_.seed(o.seed);
+  small_.create(o.input_height, o.input_width, CV_8UC3);
+  const int blob_shape[] = {1, 3, o.input_height, o.input_width};
+  blob_.create(4, blob_shape, CV_32F);
+  blob_.setTo(0.0f);
+  mask1_.create(o.mask_rows, o.mask1_size, CV_32F);
+  mask2_.create(o.mask_rows, o.mask2_size, CV_32F);
+  mask1_.setTo(1.0f);
+  mask2_.setTo(1.0f);
+  // One forward pass checks the model against the shapes the options promise.
+  try {
+    net_.setInput(blob_, "image");
+    net_.setInput(mask1_, "mask1");
+    net_.setInput(mask2_, "mask2");
+    out_ = net_.forward("azimuth_cs");
+  } catch (const cv::Exception& e) {
+    return invalidArgument(
+        "suncnn: the model does not run with the shapes of suncnn.input_width/input_height/"
+        "mask_rows/mask1_size/mask2_size: " +
+        e.msg);
+  }
+  if (out_.total() != static_cast<std::size_t>(o.mask_rows) * 2)
+    return invalidArgument(
+        "suncnn: model output has " + std::to_string(out_.total()) +
+        " values, expected suncnn.mask_rows x 2 = " + std::to_string(o.mask_rows * 2));
+  ready_ = true;
+  return Status::ok();
+}
+
+void SunCnnEstimator::fillMasks() {
+  // Inverted dropout, as torch.nn.Dropout in training: keep with probability 1 - p, scaled by
+  // 1 / (1 - p). Row 0 stays all ones (dropout off); rows beyond mc_samples are not read.
+  const float keep = static_cast<float>(1.0 / (1.0 - options_.dropout_p));
+  std::bernoulli_distribution dropped(options_.dropout_p);
+  for (cv::Mat* m : {&mask1_, &mask2_}) {
+    m->row(0).setTo(1.0f);
+    for (int r = 1; r <= options_.mc_samples; ++r) {
+      float* p = m->ptr<float>(r);
+      for (int j = 0; j < m->cols; ++j) p[j] = dropped(rng_) ? 0.0f : keep;
+    }
+  }
+}
+
+Expected<cv::Mat> SunCnnEstimator::forwardRaw(const cv::Mat& blob, const cv::Mat& mask1,
+                                              const cv::Mat& mask2) {
+  if (!ready_) return failedPrecondition("suncnn: estimator not initialised");
+  try {
+    net_.setInput(blob, "image");
+    net_.setInput(mask1, "mask1");
+    net_.setInput(mask2, "mask2");
+    return net_.forward("azimuth_cs").clone();
+  } catch (const cv::Exception& e) {
+    return invalidArgument(std::string("suncnn: forward failed: ") + e.msg);
+  }
+}
+
+Expected<sunfusion::ImageSunEstimate> SunCnnEstimator::estimate(
+    const sunfusion::ImageSunInput& input) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (!ready_) return failedPrecondition("suncnn: estimator not initialised (call init)");
+  const cv::Mat& img = input.color;
+  const SunCnnOptions& o = options_;
+  if (img.empty()) return invalidArgument("suncnn: empty image");
+  if (img.type() != CV_8UC3) return invalidArgument("suncnn: image must be CV_8UC3 (BGR)");
+  if (input.camera.width > 0 && input.camera.height > 0 &&
+      (img.cols != input.camera.width || img.rows != input.camera.height))
+    return invalidArgument("suncnn: image " + std::to_string(img.cols) + "x" +
+                           std::to_string(img.rows) + " differs from the camera's " +
+                           std::to_string(input.camera.width) + "x" +
+                           std::to_string(input.camera.height));
+  if (img.cols < o.input_width || img.rows < o.input_height)
+    return invalidArgument("suncnn: image smaller than the network input " +
+                           std::to_string(o.input_width) + "x" + std::to_string(o.input_height));
+
+  // Pre-processing exactly as in training: INTER_AREA resize, BGR planes, (v/255 - mean)/std.
+  cv::resize(img, small_, small_.size(), 0.0, 0.0, cv::INTER_AREA);
+  const float a = static_cast<float>(1.0 / (255.0 * o.pixel_std));
+  const float b = static_cast<float>(-o.pixel_mean / o.pixel_std);
+  const int plane = o.input_width * o.input_height;
+  float* dst = blob_.ptr<float>();
+  for (int y = 0; y < o.input_height; ++y) {
+    const unsigned char* src = small_.ptr<unsigned char>(y);
+    for (int x = 0; x < o.input_width; ++x)
+      for (int c = 0; c < 3; ++c)
+        dst[c * plane + y * o.input_width + x] = static_cast<float>(src[3 * x + c]) * a + b;
+  }
+  fillMasks();
+  try {
+    net_.setInput(blob_, "image");
+    net_.setInput(mask1_, "mask1");
+    net_.setInput(mask2_, "mask2");
+    net_.forward(outs_, "azimuth_cs");
+  } catch (const cv::Exception& e) {
+    return invalidArgument(std::string("suncnn: forward failed: ") + e.msg);
+  }
+  if (outs_.empty() || outs_[0].total() != static_cast<std::size_t>(o.mask_rows) * 2)
+    return invalidArgument("suncnn: unexpected model output size");
+  const float* out = outs_[0].ptr<float>();
+
+  SunCnnRaw raw;
+  raw.c = static_cast<double>(out[0]);
+  raw.s = static_cast<double>(out[1]);
+  double sum_c = 0.0, sum_s = 0.0;
+  for (int r = 1; r <= o.mc_samples; ++r) {
+    const double c = static_cast<double>(out[2 * r]), s = static_cast<double>(out[2 * r + 1]);
+    const double n = std::hypot(c, s);
+    if (n > 1e-9 && std::isfinite(n)) {
+      sum_c += c / n;
+      sum_s += s / n;
+    }  // a zero or non-finite sample adds no direction: it lowers R_mc
+  }
+  raw.r_mc = o.mc_samples > 0 ? std::hypot(sum_c, sum_s) / o.mc_samples : 1.0;
+  const bool finite = std::isfinite(raw.c) && std::isfinite(raw.s);
+  if (!finite) raw.c = raw.s = 0.0;  // no direction; sigma goes to its cap below
+  raw.r_al = std::min(std::hypot(raw.c, raw.s), 1.0);
+  raw.sigma_rad = std::clamp(
+      o.sigma_scale * std::sqrt(circularStdSquared(raw.r_mc) + circularStdSquared(raw.r_al)),
+      o.sigma_min_rad, o.sigma_max_rad);
+  raw_ = raw;
+
+  sunfusion::ImageSunEstimate e;
+  const double az = raw.r_al > 0.0 ? std::atan2(raw.s, raw.c) : 0.0;
+  e.azimuth_deg = az * kRadToDeg;
+  if (e.azimuth_deg <= -180.0) e.azimuth_deg += 360.0;
+  e.zenith_deg = 90.0;
+  e.confidence = std::clamp(raw.r_mc * raw.r_al, 0.0, 1.0);
+  e.measurement.kind = sunfusion::SunMeasurementKind::kAzimuthOnly;
+  e.measurement.sun_c = Eigen::Vector3d(std::sin(az), 0.0, std::cos(az));
+  e.measurement.sigma = raw.sigma_rad;
+  bool upright = true;
+  if (input.prior) {
+    const Eigen::Vector3d& up_c = input.prior->up_c;
+    const double n = up_c.norm();
+    upright = n > 1e-9 && std::isfinite(n) &&
+              std::acos(std::clamp(-up_c.y() / n, -1.0, 1.0)) * kRadToDeg <= o.max_up_tilt_deg;
+  }
+  e.valid = finite && upright && raw.sigma_rad <= o.max_valid_sigma_rad;
+  e.time_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return e;
+}
+
+}  // namespace sunvo::suncnn

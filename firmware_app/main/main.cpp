@@ -1,0 +1,177 @@
+// sunvo_rover: the onboard program. Reads the YAML config, starts the capture, estimator, sun
+// and telemetry threads, and runs until SIGINT/SIGTERM (or, for a replay with end: stop, until
+// the last pose is sent). SIGUSR1 writes the latency profile without stopping.
+//
+//   sunvo_rover --config config/rover.yaml [--set key=value ...]
+//
+// Exit codes: 0 clean shutdown, 2 bad command line or config, 1 any other start-up failure.
+
+#include <signal.h>
+
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "sunvo/rover/app.hpp"
+#include "sunvo/rover/config.hpp"
+#include "sunvo/rover/mavlink_link.hpp"
+#include "sunvo/runtime/allocation_meter.hpp"
+#include "sunvo/runtime/rt_setup.hpp"
+
+#ifdef SUNVO_ALLOC_COUNTER
+#include "sunvo/bench/alloc_counter.hpp"
+#endif
+
+namespace {
+
+// Resident set size of this process, kB (VmRSS of /proc/self/status); -1 if unreadable.
+long residentKb() {
+  std::FILE* f = std::fopen("/proc/self/status", "r");
+  if (f == nullptr) return -1;
+  char line[256];
+  long kb = -1;
+  while (std::fgets(line, sizeof(line), f) != nullptr) {
+    if (std::strncmp(line, "VmRSS:", 6) == 0) kb = std::strtol(line + 6, nullptr, 10);
+  }
+  std::fclose(f);
+  return kb;
+}
+
+void usage() {
+  std::fprintf(stderr,
+               "usage: sunvo_rover --config FILE [--set key=value]...\n"
+               "  --config FILE     YAML config (config/rover.yaml, config/rover_replay.yaml)\n"
+               "  --set key=value   override one config key, e.g. --set serial.device=/dev/pts/3\n"
+               "signals: SIGINT/SIGTERM stop cleanly, SIGUSR1 writes the latency profile\n");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string config_path;
+  std::vector<std::pair<std::string, std::string>> overrides;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--config" && i + 1 < argc) {
+      config_path = argv[++i];
+    } else if (a == "--set" && i + 1 < argc) {
+      const std::string kv = argv[++i];
+      const auto eq = kv.find('=');
+      if (eq == std::string::npos || eq == 0) {
+        std::fprintf(stderr, "sunvo_rover: --set %s: expected key=value\n", kv.c_str());
+        return 2;
+      }
+      overrides.emplace_back(kv.substr(0, eq), kv.substr(eq + 1));
+    } else if (a == "--help" || a == "-h") {
+      usage();
+      return 0;
+    } else {
+      std::fprintf(stderr, "sunvo_rover: unknown argument '%s'\n", a.c_str());
+      usage();
+      return 2;
+    }
+  }
+  if (config_path.empty()) {
+    usage();
+    return 2;
+  }
+  auto config = sunvo::rover::loadRoverConfig(config_path, overrides);
+  if (!config) {
+    std::fprintf(stderr, "sunvo_rover: %s\n", config.status().message().c_str());
+    return 2;
+  }
+  std::printf("%s", config->describe().c_str());
+
+  // Before any thread exists: one malloc arena, no mmap blocks, no trimming.
+  if (config->rt.heap_reserve_mb > 0) {
+    const std::string w = sunvo::runtime::configureRealTimeHeap();
+    if (!w.empty()) std::fprintf(stderr, "sunvo_rover: %s\n", w.c_str());
+  }
+#ifdef SUNVO_ALLOC_COUNTER
+  sunvo::runtime::setThreadAllocationProbe(&sunvo::bench::threadAllocationCount);
+#endif
+
+  // Signals are blocked in every thread (the threads inherit the mask) and taken here.
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGUSR1);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+
+  std::unique_ptr<sunvo::rover::PoseLink> link;
+  if (!config->serial.device.empty()) {
+    auto l = sunvo::rover::MavlinkSerialLink::open(config->serial, config->telemetry);
+    if (!l) {
+      std::fprintf(stderr, "sunvo_rover: serial.device: %s\n", l.status().message().c_str());
+      return 1;
+    }
+    link = std::move(*l);
+  }
+  auto app = sunvo::rover::RoverApp::create(*config, std::move(link));
+  if (!app) {
+    std::fprintf(stderr, "sunvo_rover: %s\n", app.status().message().c_str());
+    return app.status().code() == sunvo::StatusCode::kInvalidArgument ? 2 : 1;
+  }
+  {
+    const std::string w =
+        sunvo::runtime::reserveHeap(static_cast<std::size_t>(config->rt.heap_reserve_mb) << 20);
+    if (!w.empty()) std::fprintf(stderr, "sunvo_rover: %s\n", w.c_str());
+  }
+  const long rss_start_kb = residentKb();  // every buffer allocated, threads not started
+  for (const std::string& w : (*app)->start()) std::fprintf(stderr, "sunvo_rover: %s\n", w.c_str());
+  std::printf("sunvo_rover: running (pid %d)\n", static_cast<int>(getpid()));
+  std::fflush(stdout);
+
+  // RSS once the warm-up frames are through, and at the end: growth = a leak or a buffer that
+  // grows.
+  const auto warmup = static_cast<std::uint64_t>(config->estimator.warmup_frames);
+  long rss_warm_kb = -1;
+  std::uint64_t rss_warm_frame = 0;
+  int dumps = 0;
+  const char* reason = "end of the replay";
+  for (;;) {
+    timespec tick{0, 50'000'000};
+    const int sig = sigtimedwait(&signals, nullptr, &tick);
+    if (sig == SIGUSR1) {
+      auto text = (*app)->writeProfile("sigusr1_" + std::to_string(++dumps));
+      std::fprintf(stderr, "sunvo_rover: SIGUSR1: profile %s\n",
+                   text ? "written" : text.status().message().c_str());
+      continue;
+    }
+    if (sig == SIGINT || sig == SIGTERM) {
+      reason = sig == SIGINT ? "SIGINT" : "SIGTERM";
+      break;
+    }
+    if (rss_warm_kb < 0 && (*app)->framesProcessed() >= warmup) {
+      rss_warm_frame = (*app)->framesProcessed();
+      rss_warm_kb = residentKb();
+    }
+    if ((*app)->finished()) break;
+  }
+  (*app)->requestStop();
+  (*app)->join();
+  const long rss_end_kb = residentKb();
+  auto profile = (*app)->writeProfile("final");
+  std::printf("sunvo_rover: stopped (%s)\n%s", reason, (*app)->summary().c_str());
+  if (rss_warm_kb >= 0) {
+    std::printf(
+        "  rss: %ld kB at start, %ld kB after warm-up (frame %llu), %ld kB at the end: "
+        "growth after warm-up %ld kB\n",
+        rss_start_kb, rss_warm_kb, static_cast<unsigned long long>(rss_warm_frame), rss_end_kb,
+        rss_end_kb - rss_warm_kb);
+  } else {
+    std::printf("  rss: %ld kB at start, %ld kB at the end (warm-up not reached)\n", rss_start_kb,
+                rss_end_kb);
+  }
+  if (!profile) {
+    std::fprintf(stderr, "sunvo_rover: profile: %s\n", profile.status().message().c_str());
+  } else {
+    std::printf("  profile: %s/final_latency.csv, final_trace.json, final_latency_summary.txt\n",
+                config->profiling.output_dir.c_str());
+  }
+  std::fflush(stdout);
+  return 0;
+}

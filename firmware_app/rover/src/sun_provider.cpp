@@ -1,0 +1,48 @@
+#include "sunvo/rover/sun_provider.hpp"
+
+namespace sunvo::rover {
+
+Expected<std::optional<sunfusion::SunMeasurement>> CsvSunProvider::measure(const SunQuery& q) {
+  if (q.source_index < 0 || static_cast<std::size_t>(q.source_index) >= csv_.sun_c.size()) {
+    return std::optional<sunfusion::SunMeasurement>();
+  }
+  sunfusion::SunMeasurement m;
+  m.time_ns = q.utc_ns;
+  m.sequence = q.sequence;
+  m.kind = sunfusion::SunMeasurementKind::kFull3d;
+  m.sun_c = csv_.sun_c[static_cast<std::size_t>(q.source_index)];
+  m.sigma = sigma_;
+  return std::optional<sunfusion::SunMeasurement>(m);
+}
+
+Expected<std::optional<sunfusion::SunMeasurement>> ImageSunProvider::measure(const SunQuery& q) {
+  if (q.images == nullptr || q.images->left_color.empty()) {
+    return failedPrecondition(std::string(name()) + ": no colour image for frame " +
+                              std::to_string(q.sequence));
+  }
+  sunfusion::ImageSunInput in{q.images->left_color, camera_, q.prior};
+  auto e = estimator_->estimate(in);
+  if (!e) return e.status();
+  if (!e->valid) return std::optional<sunfusion::SunMeasurement>();
+  sunfusion::SunMeasurement m = e->measurement;
+  m.sequence = q.sequence;
+  m.time_ns = q.utc_ns;
+  return std::optional<sunfusion::SunMeasurement>(m);
+}
+
+Expected<std::unique_ptr<SunProvider>> makeSunProvider(const SunConfig& config,
+                                                       const StereoCamera& camera) {
+  (void)camera;  // for the image estimators, e.g. ImageSunProvider(makeLalonde(...), camera)
+  switch (config.provider) {
+    case SunProviderType::kNone:
+      return std::unique_ptr<SunProvider>();
+    case SunProviderType::kCsv: {
+      auto csv = files::readSunCsv(config.csv);
+      if (!csv) return Status(csv.status().code(), "sun.csv: " + csv.status().message());
+      return std::unique_ptr<SunProvider>(new CsvSunProvider(std::move(*csv), config.sigma));
+    }
+  }
+  return invalidArgument("sun.provider: unknown");
+}
+
+}  // namespace sunvo::rover

@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# Sun-CNN: renders the training and held-out drives (skipped when already rendered), writes the
+# manifest and the SHA-256 of the training data, trains with PyTorch (CPU) and exports
+# config/sun_cnn.onnx + config/sun_cnn.json + the parity reference.
+#
+#   bash scripts/train_sun_cnn.sh                 # render what is missing, then train
+#   bash scripts/train_sun_cnn.sh --render-only   # only render (and write the manifest)
+#
+# Needs: the sunvo_render tool (built here if missing), povray, and python3-torch
+# (bash scripts/setup.sh --train). Renders go to $SUNVO_RENDERS (default /work/renders), one
+# folder per scenario: train_* (training, config/scenarios/train_*.yaml) and val_* (held out).
+set -euo pipefail
+ROOT="$(cd "$(dirname "$0")/.." && pwd)"
+BUILD="${SUNVO_BUILD:-$ROOT/build/release}"
+RENDERS="${SUNVO_RENDERS:-/work/renders}"
+JOBS="${JOBS:-2}"
+PY=/usr/bin/python3  # Debian's interpreter, the one python3-torch is installed for
+MODE="${1:-all}"
+
+if [ ! -x "$BUILD/hil/render/sunvo_render" ]; then
+  (cd "$ROOT" && cmake --preset release >/dev/null && cmake --build "$BUILD" --target sunvo_render_tool)
+fi
+
+mkdir -p "$RENDERS"
+for yaml in "$ROOT"/config/scenarios/train_*.yaml "$ROOT"/config/scenarios/val_*.yaml; do
+  name="$(basename "$yaml" .yaml)"
+  out="$RENDERS/$name"
+  # RENDERED holds the SHA-256 of the scenario it was rendered from: a changed scenario renders again.
+  want="$(sha256sum "$yaml" | cut -d' ' -f1)"
+  if [ -f "$out/RENDERED" ] && [ "$(cat "$out/RENDERED")" = "$want" ]; then continue; fi
+  rm -rf "$out"
+  echo "train_sun_cnn: rendering $name"
+  nice -n 10 "$BUILD/hil/render/sunvo_render" --scenario "$yaml" --out "$out" -j "$JOBS"
+  rm -rf "$out"/*/*_sync/pov   # POV-Ray sources and sky maps: not needed for training
+  echo "$want" >"$out/RENDERED"
+done
+
+"$PY" "$ROOT/estimator/suncnn/training/sun_cnn_manifest.py" --renders "$RENDERS" \
+  --out "$RENDERS/sun_cnn_manifest.csv"
+[ "$MODE" = "--render-only" ] && exit 0
+
+"$PY" -c "import torch" 2>/dev/null || {
+  echo "train_sun_cnn: python3-torch missing: bash scripts/setup.sh --train" >&2
+  exit 1
+}
+nice -n 10 "$PY" "$ROOT/estimator/suncnn/training/sun_cnn_train.py" \
+  --manifest "$RENDERS/sun_cnn_manifest.csv" --out-dir "$ROOT/config" \
+  --reference "$ROOT/tests/suncnn/data/sun_cnn_reference.txt"

@@ -1,0 +1,132 @@
+// The whole program on a rendered drive: sunvo_pose_reader opens a pseudo-terminal, starts
+// sunvo_rover (config/rover_replay.yaml) writing its MAVLink stream into it, decodes every pose,
+// stops the program with SIGTERM, and evaluates accuracy and latency. Compared with the
+// sequential replay (sunvo_replay's chain) on the same frames.
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include "sunvo/metrics/metrics.hpp"
+#include "sunvo/render/drive.hpp"
+#include "sunvo/replay/replay.hpp"
+
+namespace sunvo {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The 100-frame CI drive when scripts/demo.sh has rendered it into this build's render cache;
+// otherwise the first 20 frames of the same scenario, rendered once (as tests/replay does) and
+// kept in test_render_cache/rover_20.
+std::string findOrRenderDrive(int* frames) {
+  const fs::path cache = fs::path(SUNVO_BINARY_DIR) / "render_cache" / "ci_short";
+  if (fs::exists(cache)) {
+    for (const auto& date : fs::directory_iterator(cache)) {
+      if (!date.is_directory()) continue;
+      for (const auto& d : fs::directory_iterator(date.path())) {
+        if (d.path().filename().string().ends_with("_sync") &&
+            fs::exists(d.path() / "gt" / "poses_cam0_enu.txt")) {
+          *frames = 100;
+          return d.path().string();
+        }
+      }
+    }
+  }
+  auto scenario =
+      render::loadScenario(std::string(SUNVO_SOURCE_DIR) + "/config/scenarios/ci_short.yaml");
+  if (!scenario) return {};
+  scenario->frames = 20;
+  *frames = 20;
+  const fs::path out = fs::path(SUNVO_BINARY_DIR) / "test_render_cache" / "rover_20";
+  const fs::path done = out / "complete";
+  if (fs::exists(done)) {
+    std::ifstream in(done);
+    std::string drive;
+    std::getline(in, drive);
+    if (fs::exists(fs::path(drive) / "gt" / "poses_cam0_enu.txt")) return drive;
+  }
+  fs::remove_all(out);
+  auto drive = render::renderDrive(*scenario, out.string(), 2, {});
+  if (!drive) return {};
+  std::ofstream(done) << *drive << "\n";
+  return *drive;
+}
+
+double jsonNumber(const std::string& json, const std::string& key) {
+  const std::regex re("\"" + key + "\": ([-0-9.eE]+)");
+  std::smatch m;
+  if (!std::regex_search(json, m, re)) {
+    ADD_FAILURE() << "no " << key << " in " << json;
+    return -1.0;
+  }
+  return std::atof(m[1].str().c_str());
+}
+
+TEST(RoverReplay, WholeProgramIntoAPseudoTerminal) {
+  int frames = 0;
+  const std::string drive = findOrRenderDrive(&frames);
+  ASSERT_FALSE(drive.empty()) << "no rendered drive";
+  const fs::path out = fs::path(SUNVO_BINARY_DIR) / "test_out" / "rover_replay";
+  fs::remove_all(out);
+  fs::create_directories(out);
+  const std::string emu = SUNVO_TOOL_EMULATOR;
+  const std::string bin = SUNVO_BINARY_DIR;
+  const std::string cmd =
+      emu + bin + "/hil/pose_reader/sunvo_pose_reader --drive " + drive + " --frames " +
+      std::to_string(frames) + " --timeout-s 45 --json " + (out / "reader.json").string() +
+      " --child-log " + (out / "rover.log").string() + " --latency-csv " +
+      (out / "final_latency.csv").string() + " -- " + emu + bin +
+      "/firmware_app/main/sunvo_rover --config " + SUNVO_SOURCE_DIR +
+      "/config/rover_replay.yaml --set source.kitti.drive_dir=" + drive +
+      " --set sun.csv=" + drive +
+      "/gt/sun_cam0.csv --set serial.device={pty} --set profiling.output_dir=" + out.string() +
+      " > " + (out / "reader.txt").string() + " 2>&1";
+  const int rc = std::system(cmd.c_str());
+  std::stringstream json_text, log_text;
+  json_text << std::ifstream(out / "reader.json").rdbuf();
+  log_text << std::ifstream(out / "rover.log").rdbuf();
+  const std::string json = json_text.str();
+  std::printf("%s\n%s\n", log_text.str().c_str(), json.c_str());
+  EXPECT_EQ(rc, 0);
+  // Every pose arrived once, CRCs good, clean shutdown on SIGTERM with the summary.
+  EXPECT_EQ(jsonNumber(json, "odometry_received"), frames);
+  EXPECT_EQ(jsonNumber(json, "missing"), 0);
+  EXPECT_EQ(jsonNumber(json, "crc_errors"), 0);
+  EXPECT_EQ(jsonNumber(json, "seq_gaps"), 0);
+  EXPECT_GE(jsonNumber(json, "heartbeats"), 1);
+  EXPECT_NE(json.find("\"clean_exit\": true"), std::string::npos);
+  EXPECT_NE(json.find("\"summary_printed\": true"), std::string::npos);
+  EXPECT_NE(log_text.str().find("queue frames"), std::string::npos);
+  // Every frame went through the profiler; its latency reached the reader.
+  EXPECT_EQ(jsonNumber(json, "n"), frames);
+  EXPECT_TRUE(fs::exists(out / "final_trace.json"));
+
+  // Accuracy close to the sequential replay of the same frames with the same true sun.
+  replay::ReplayOptions ro;
+  ro.drive_dir = drive;
+  ro.max_frames = frames;
+  auto data = replay::loadReplayData(ro);
+  ASSERT_TRUE(data) << data.status().toString();
+  data->T_w_c_gt.resize(static_cast<std::size_t>(frames));
+  auto seq = replay::replayDrive(ro, experiment::defaultSunSources(1)[0]);
+  ASSERT_TRUE(seq) << seq.status().toString();
+  metrics::EvaluationOptions eo;
+  eo.plane = metrics::HorizontalPlane::kEastNorth;
+  auto ev = metrics::evaluate(data->T_w_c_gt, seq->T_w_c, eo);
+  ASSERT_TRUE(ev);
+  const double drift_rover = jsonNumber(json, "final_drift_m");
+  const double rot_rover = jsonNumber(json, "rot_armse_rad");
+  std::printf("final drift: program %.4f m, sequential replay %.4f m; rot ARMSE %.3g / %.3g rad\n",
+              drift_rover, ev->table1.final_drift_m, rot_rover, ev->table1.rot_armse_rad);
+  EXPECT_LT(std::abs(drift_rover - ev->table1.final_drift_m),
+            0.02 + 0.5 * ev->table1.final_drift_m);
+  EXPECT_LT(rot_rover, 2.0 * ev->table1.rot_armse_rad + 1e-3);
+}
+
+}  // namespace
+}  // namespace sunvo

@@ -1,0 +1,59 @@
+// Runs the real sunvo_sun_eval on the 11 real KITTI 00 frames and checks what it writes.
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace {
+namespace fs = std::filesystem;
+const std::string kExe = SUNVO_SUN_EVAL_EXE;
+const std::string kFrames = std::string(SUNVO_DATA_DIR) + "/kitti_odometry/00_first_frames";
+const std::string kOut = std::string(SUNVO_BINARY_DIR) + "/sun_eval_cli_test_out";
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+int run(const std::string& args) {
+  const std::string cmd = std::string(SUNVO_TOOL_EMULATOR) + kExe + " " + args + " > " + kOut +
+                          "_stdout.txt 2> " + kOut + "_stderr.txt";
+  const int status = std::system(cmd.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+TEST(SunEvalCli, EvaluatesTheRealKittiFrames) {
+  fs::remove_all(kOut);
+  ASSERT_EQ(run("--images " + kFrames + " --out " + kOut + " --debug 1"), 0)
+      << slurp(kOut + "_stderr.txt");
+  const std::string md = slurp(kOut + "/sun_eval.md");
+  EXPECT_NE(md.find("| lalonde | 00_first_frames | 11 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| lalonde_vo | 00_first_frames | 11 |"), std::string::npos) << md;
+  const std::string json = slurp(kOut + "/sun_eval.json");
+  EXPECT_NE(json.find("\"estimator\": \"lalonde_vo\""), std::string::npos);
+  EXPECT_EQ(json.find("nan"), std::string::npos);
+  for (const char* f :
+       {"hist/lalonde_00_first_frames_azimuth.png", "hist/lalonde_vo_00_first_frames_zenith.png",
+        "debug/lalonde_00_first_frames_0.png", "frames/lalonde_00_first_frames.csv"}) {
+    EXPECT_GT(fs::file_size(fs::path(kOut) / f), 100u) << f;
+  }
+  // One header line and one line per frame.
+  const std::string csv = slurp(kOut + "/frames/lalonde_vo_00_first_frames.csv");
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 12);
+}
+
+TEST(SunEvalCli, RejectsBadArguments) {
+  EXPECT_EQ(run("--out " + kOut), 2);
+  EXPECT_EQ(run("--images /nonexistent --out " + kOut), 2);
+  EXPECT_EQ(run("--images " + kFrames + " --out " + kOut + " --estimators nope"), 2);
+  EXPECT_NE(slurp(kOut + "_stderr.txt").find("unknown sun estimator 'nope'"), std::string::npos);
+}
+
+}  // namespace

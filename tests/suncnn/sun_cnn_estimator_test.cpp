@@ -1,0 +1,276 @@
+// Sun-CNN estimator: the shipped model against PyTorch (parity), on rendered frames of a held-out
+// scenario (accuracy), on degenerate images (uncertainty), and with wrong input (errors).
+#include "sunvo/suncnn/sun_cnn_estimator.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <memory>
+#include <numbers>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+
+#include "sunvo/render/drive.hpp"
+
+namespace sunvo::suncnn {
+namespace {
+
+const std::string kModel = std::string(SUNVO_SOURCE_DIR) + "/config/sun_cnn.onnx";
+// Bounds on the azimuth error over the 16 held-out images (val_rome_july_morning frames 0-7, both
+// cameras). Measured with the shipped model: median 6.1 deg, max 11.0 deg.
+constexpr double kMedianBoundDeg = 15.0;
+constexpr double kMaxBoundDeg = 45.0;
+const std::string kReference =
+    std::string(SUNVO_SOURCE_DIR) + "/tests/suncnn/data/sun_cnn_reference.txt";
+
+// A fresh estimator per test (default options, seed 1), so results do not depend on test order.
+std::unique_ptr<SunCnnEstimator> shippedModel() {
+  auto est = std::make_unique<SunCnnEstimator>();
+  const Status st = est->init(SunCnnOptions{}, kModel);
+  EXPECT_TRUE(st.isOk()) << st.toString();
+  return est;
+}
+
+sunfusion::ImageSunInput inputOf(const cv::Mat& img) {
+  sunfusion::ImageSunInput in;
+  in.color = img;
+  in.camera = StereoCamera{240.5126, 240.5126, 202.8531, 57.2847, 0.537, img.cols, img.rows};
+  return in;
+}
+
+double azimuthDeg(const Eigen::Vector3d& s) {
+  return std::atan2(s.x(), s.z()) * 180.0 / std::numbers::pi;
+}
+
+// A few frames of a scenario never used in training (val_*), rendered once per build folder.
+struct HeldOutFrames {
+  std::vector<cv::Mat> images;
+  std::vector<Eigen::Vector3d> sun_c;
+};
+const HeldOutFrames& heldOutFrames() {
+  static HeldOutFrames f = [] {
+    HeldOutFrames r;
+    auto s = render::loadScenario(std::string(SUNVO_SOURCE_DIR) +
+                                  "/config/scenarios/val_rome_july_morning.yaml");
+    EXPECT_TRUE(s.hasValue()) << s.status().toString();
+    if (!s) return r;
+    s->frames = 8;
+    const auto out = std::filesystem::path(SUNVO_BINARY_DIR) / "test_render_cache" / "suncnn_8";
+    // Rendered once per build folder (about 10 s); the drive folder name is fixed by the scenario.
+    Expected<std::string> rendered = (out / "2026_07_14" / "2026_07_14_drive_0314_sync").string();
+    if (!std::filesystem::exists(*rendered + "/image_03/data/0000000007.png"))
+      rendered = render::renderDrive(*s, out.string(), 2, {});
+    EXPECT_TRUE(rendered.hasValue()) << rendered.status().toString();
+    if (!rendered) return r;
+    std::ifstream csv(*rendered + "/gt/sun_cam0.csv");
+    std::string line;
+    std::getline(csv, line);
+    while (std::getline(csv, line)) {
+      int k = 0;
+      double x = 0, y = 0, z = 0;
+      if (std::sscanf(line.c_str(), "%d,%lf,%lf,%lf", &k, &x, &y, &z) != 4) continue;
+      char fn[32];
+      std::snprintf(fn, sizeof fn, "%010d.png", k);
+      for (const char* cam : {"/image_02/data/", "/image_03/data/"}) {
+        r.images.push_back(cv::imread(*rendered + cam + fn, cv::IMREAD_COLOR));
+        r.sun_c.emplace_back(x, y, z);
+      }
+    }
+    return r;
+  }();
+  return f;
+}
+
+TEST(SunCnnEstimator, MatchesPyTorchOnAFixedInput) {
+  auto est_ptr = shippedModel();
+  SunCnnEstimator& est = *est_ptr;
+  ASSERT_TRUE(est.initialised());
+  std::ifstream f(kReference);
+  ASSERT_TRUE(f.good()) << kReference;
+  const SunCnnOptions o;
+  // input[c, y, x] = ((7c + 13y + 3x) mod 29) / 29 - 0.5, as in sun_cnn_train.py.
+  const int shape[] = {1, 3, o.input_height, o.input_width};
+  cv::Mat blob(4, shape, CV_32F);
+  float* p = blob.ptr<float>();
+  for (int c = 0; c < 3; ++c)
+    for (int y = 0; y < o.input_height; ++y)
+      for (int x = 0; x < o.input_width; ++x)
+        *p++ = static_cast<float>(((7 * c + 13 * y + 3 * x) % 29) / 29.0 - 0.5);
+  cv::Mat m1(o.mask_rows, o.mask1_size, CV_32F, cv::Scalar(1.0f));
+  cv::Mat m2(o.mask_rows, o.mask2_size, CV_32F, cv::Scalar(1.0f));
+  const float keep = static_cast<float>(1.0 / (1.0 - o.dropout_p));
+  for (int j = 0; j < o.mask1_size; ++j) m1.at<float>(1, j) = j % 3 == 0 ? 0.0f : keep;
+  for (int j = 0; j < o.mask2_size; ++j) m2.at<float>(1, j) = j % 4 == 1 ? 0.0f : keep;
+  auto out = est.forwardRaw(blob, m1, m2);
+  ASSERT_TRUE(out.hasValue()) << out.status().toString();
+  std::string line;
+  int rows = 0;
+  double max_diff = 0.0;
+  while (std::getline(f, line)) {
+    std::istringstream ss(line);
+    std::string key;
+    ss >> key;
+    if (key == "model_bytes") {
+      std::uintmax_t bytes = 0;
+      ss >> bytes;
+      EXPECT_EQ(std::filesystem::file_size(kModel), bytes)
+          << "the reference belongs to another model: re-run scripts/train_sun_cnn.sh";
+    } else if (key == "row0" || key == "row1") {
+      const int r = key == "row0" ? 0 : 1;
+      double c = 0, s = 0;
+      ss >> c >> s;
+      const double dc = static_cast<double>(out->at<float>(r, 0)) - c;
+      const double ds = static_cast<double>(out->at<float>(r, 1)) - s;
+      EXPECT_LT(std::fabs(dc), 1e-4) << key;
+      EXPECT_LT(std::fabs(ds), 1e-4) << key;
+      max_diff = std::max({max_diff, std::fabs(dc), std::fabs(ds)});
+      ++rows;
+    }
+  }
+  EXPECT_EQ(rows, 2);
+  std::printf("OpenCV DNN vs PyTorch: max |difference| %.2e\n", max_diff);
+}
+
+TEST(SunCnnEstimator, FindsTheSunOnHeldOutRenderedFrames) {
+  auto est_ptr = shippedModel();
+  SunCnnEstimator& est = *est_ptr;
+  const HeldOutFrames& f = heldOutFrames();
+  ASSERT_EQ(f.images.size(), 16u);
+  std::vector<double> err, sigma;
+  for (std::size_t i = 0; i < f.images.size(); ++i) {
+    ASSERT_FALSE(f.images[i].empty());
+    auto e = est.estimate(inputOf(f.images[i]));
+    ASSERT_TRUE(e.hasValue()) << e.status().toString();
+    EXPECT_TRUE(std::isfinite(e->azimuth_deg) && std::isfinite(e->measurement.sigma));
+    EXPECT_EQ(e->measurement.kind, sunfusion::SunMeasurementKind::kAzimuthOnly);
+    EXPECT_DOUBLE_EQ(e->measurement.sun_c.y(), 0.0);
+    EXPECT_NEAR(e->measurement.sun_c.norm(), 1.0, 1e-12);
+    err.push_back(std::fabs(std::remainder(e->azimuth_deg - azimuthDeg(f.sun_c[i]), 360.0)));
+    sigma.push_back(e->measurement.sigma);
+  }
+  std::sort(err.begin(), err.end());
+  std::sort(sigma.begin(), sigma.end());
+  std::printf(
+      "held-out rendered frames: azimuth error median %.1f deg, max %.1f deg; sigma median "
+      "%.3f rad\n",
+      err[err.size() / 2], err.back(), sigma[sigma.size() / 2]);
+  EXPECT_LT(err[err.size() / 2], kMedianBoundDeg);
+  EXPECT_LT(err.back(), kMaxBoundDeg);
+}
+
+TEST(SunCnnEstimator, UncertaintyGrowsOnImagesWithoutSunCues) {
+  auto est_ptr = shippedModel();
+  SunCnnEstimator& est = *est_ptr;
+  const HeldOutFrames& f = heldOutFrames();
+  ASSERT_FALSE(f.images.empty());
+  std::vector<double> sigma_real;
+  for (const cv::Mat& img : f.images)
+    sigma_real.push_back(est.estimate(inputOf(img))->measurement.sigma);
+  std::sort(sigma_real.begin(), sigma_real.end());
+  const double median_real = sigma_real[sigma_real.size() / 2];
+
+  const cv::Size size = f.images[0].size();
+  cv::Mat black(size, CV_8UC3, cv::Scalar::all(0));
+  cv::Mat grey(size, CV_8UC3, cv::Scalar::all(128));
+  cv::Mat noise(size, CV_8UC3);
+  cv::RNG rng(5);
+  rng.fill(noise, cv::RNG::UNIFORM, 0, 256);
+  for (const auto& [name, img] : {std::pair{"black", black}, {"grey", grey}, {"noise", noise}}) {
+    auto e = est.estimate(inputOf(img));
+    ASSERT_TRUE(e.hasValue()) << name;
+    EXPECT_TRUE(std::isfinite(e->azimuth_deg)) << name;
+    EXPECT_TRUE(std::isfinite(e->measurement.sigma)) << name;
+    EXPECT_TRUE(std::isfinite(e->measurement.sun_c.norm())) << name;
+    EXPECT_GT(e->measurement.sigma, 1.5 * median_real) << name;
+    EXPECT_FALSE(e->valid) << name << ": sigma " << e->measurement.sigma;
+    std::printf("%s image: sigma %.3f rad (held-out frames: median %.3f rad)\n", name,
+                e->measurement.sigma, median_real);
+  }
+}
+
+TEST(SunCnnEstimator, McSamplesAreReproducibleForASeed) {
+  const HeldOutFrames& f = heldOutFrames();
+  ASSERT_FALSE(f.images.empty());
+  SunCnnOptions o;
+  o.mc_samples = 8;
+  SunCnnEstimator a, b, none;
+  ASSERT_TRUE(a.init(o, kModel).isOk());
+  ASSERT_TRUE(b.init(o, kModel).isOk());
+  o.mc_samples = 0;
+  ASSERT_TRUE(none.init(o, kModel).isOk());
+  auto ea = a.estimate(inputOf(f.images[0]));
+  auto eb = b.estimate(inputOf(f.images[0]));
+  auto en = none.estimate(inputOf(f.images[0]));
+  ASSERT_TRUE(ea && eb && en);
+  EXPECT_EQ(ea->measurement.sigma, eb->measurement.sigma);
+  EXPECT_EQ(ea->azimuth_deg, en->azimuth_deg);  // row 0 has dropout off whatever N is
+  EXPECT_LT(a.lastRaw().r_mc, 1.0);             // dropout samples do spread
+  EXPECT_EQ(none.lastRaw().r_mc, 1.0);
+  // The next call draws new masks.
+  auto ea2 = a.estimate(inputOf(f.images[0]));
+  ASSERT_TRUE(ea2.hasValue());
+  EXPECT_NE(a.lastRaw().r_mc, b.lastRaw().r_mc);
+}
+
+TEST(SunCnnEstimator, RejectsWrongInput) {
+  SunCnnEstimator fresh;
+  const cv::Mat img(125, 414, CV_8UC3, cv::Scalar::all(100));
+  auto e = fresh.estimate(inputOf(img));
+  ASSERT_FALSE(e.hasValue());
+  EXPECT_EQ(e.status().code(), StatusCode::kFailedPrecondition);
+
+  auto est_ptr = shippedModel();
+  SunCnnEstimator& est = *est_ptr;
+  EXPECT_FALSE(est.estimate(inputOf(cv::Mat())).hasValue());
+  EXPECT_FALSE(est.estimate(inputOf(cv::Mat(125, 414, CV_8UC1, cv::Scalar(0)))).hasValue());
+  EXPECT_FALSE(est.estimate(inputOf(cv::Mat(125, 414, CV_32FC3, cv::Scalar::all(0)))).hasValue());
+  auto in = inputOf(img);
+  in.camera.width = 1242;
+  auto wrong_size = est.estimate(in);
+  ASSERT_FALSE(wrong_size.hasValue());
+  EXPECT_NE(wrong_size.status().message().find("differs from the camera"), std::string::npos);
+  EXPECT_FALSE(est.estimate(inputOf(cv::Mat(32, 100, CV_8UC3, cv::Scalar::all(0)))).hasValue());
+
+  SunCnnOptions o;
+  o.mc_samples = 40;
+  Status st = SunCnnEstimator().init(o, kModel);
+  EXPECT_NE(st.message().find("suncnn.mc_samples"), std::string::npos) << st.toString();
+  o = SunCnnOptions{};
+  o.mask1_size = 100;  // does not match the model
+  st = SunCnnEstimator().init(o, kModel);
+  EXPECT_FALSE(st.isOk());
+  EXPECT_NE(st.message().find("mask1_size"), std::string::npos) << st.toString();
+  st = SunCnnEstimator().init(SunCnnOptions{}, std::string(SUNVO_SOURCE_DIR) + "/no_such.onnx");
+  EXPECT_FALSE(st.isOk());
+  EXPECT_NE(st.message().find("no_such.onnx"), std::string::npos);
+  const std::vector<unsigned char> junk(100, 7);
+  EXPECT_FALSE(SunCnnEstimator().init(SunCnnOptions{}, junk).isOk());
+
+  // The model from bytes behaves as the model from the file.
+  std::ifstream mf(kModel, std::ios::binary);
+  const std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(mf)),
+                                         std::istreambuf_iterator<char>());
+  SunCnnEstimator from_bytes;
+  ASSERT_TRUE(from_bytes.init(SunCnnOptions{}, bytes).isOk());
+  const HeldOutFrames& f = heldOutFrames();
+  ASSERT_FALSE(f.images.empty());
+  SunCnnEstimator from_file;
+  ASSERT_TRUE(from_file.init(SunCnnOptions{}, kModel).isOk());
+  EXPECT_EQ(from_bytes.estimate(inputOf(f.images[0]))->azimuth_deg,
+            from_file.estimate(inputOf(f.images[0]))->azimuth_deg);
+
+  // A tilted camera (up far from -y): the azimuth in the x-z plane means little; not valid.
+  in = inputOf(f.images[0]);
+  in.prior = sunfusion::SunPrior{};
+  in.prior->up_c = Eigen::Vector3d(0, 0, 1);
+  auto tilted = est.estimate(in);
+  ASSERT_TRUE(tilted.hasValue());
+  EXPECT_FALSE(tilted->valid);
+}
+
+}  // namespace
+}  // namespace sunvo::suncnn

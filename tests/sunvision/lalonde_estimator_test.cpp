@@ -1,0 +1,185 @@
+#include "sunvo/sunvision/lalonde_estimator.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <opencv2/imgproc.hpp>
+
+#include "synthetic_scene.hpp"
+
+namespace sunvo::sunvision {
+namespace {
+using sunfusion::ImageSunEstimate;
+using sunfusion::ImageSunInput;
+using sunfusion::SunPrior;
+using testing::kittiCamera;
+using testing::renderScene;
+using testing::sunInLevelCamera;
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+LalondeEstimator make(LalondePrior prior) {
+  LalondeOptions o;
+  o.prior = prior;
+  LalondeEstimator e(o);
+  EXPECT_TRUE(e.init().isOk());
+  return e;
+}
+
+// Azimuth of sun_c from the optical axis toward the right (level camera), deg.
+double azimuthDeg(const Eigen::Vector3d& sun_c) {
+  return std::atan2(sun_c.x(), sun_c.z()) / kDeg;
+}
+double azimuthErrorDeg(double a, double b) {
+  return std::abs(wrapPi((a - b) * kDeg)) / kDeg;
+}
+
+void expectFinite(const ImageSunEstimate& e) {
+  EXPECT_TRUE(e.measurement.sun_c.allFinite());
+  EXPECT_NEAR(e.measurement.sun_c.norm(), 1.0, 1e-9);
+  EXPECT_TRUE(std::isfinite(e.azimuth_deg) && std::isfinite(e.zenith_deg));
+  EXPECT_TRUE(std::isfinite(e.measurement.sigma) && e.measurement.sigma > 0.0);
+  EXPECT_TRUE(e.confidence >= 0.0 && e.confidence <= 1.0);
+  EXPECT_TRUE(std::isfinite(e.time_ms) && e.time_ms >= 0.0);
+}
+
+TEST(Lalonde, RecoversTheSunFromSkyAndShadows) {
+  LalondeEstimator est = make(LalondePrior::kZenith);
+  const StereoCamera cam = kittiCamera();
+  for (const auto& [az, zen] : {std::pair{30.0, 45.0}, std::pair{-50.0, 55.0}}) {
+    const Eigen::Vector3d sun_c = sunInLevelCamera(az, zen);
+    const ImageSunInput in{renderScene(cam, sun_c, true, true), cam, SunPrior{}};
+    Expected<ImageSunEstimate> e = est.estimate(in);
+    ASSERT_TRUE(e) << e.status().toString();
+    expectFinite(*e);
+    EXPECT_TRUE(e->valid);
+    EXPECT_TRUE(est.lastCues().sky_informative);
+    EXPECT_TRUE(est.lastCues().shadow_informative);
+    EXPECT_LT(azimuthErrorDeg(e->azimuth_deg, az), 8.0) << "true az " << az;
+    EXPECT_LT(std::abs(e->zenith_deg - zen), 15.0) << "true zenith " << zen;
+    EXPECT_NEAR(e->azimuth_deg, azimuthDeg(e->measurement.sun_c), 1e-9);
+  }
+}
+
+TEST(Lalonde, ShadowsAloneGiveTwoPeaksAndTheVoPriorPicksOne) {
+  const StereoCamera cam = kittiCamera();
+  const double az = 120.0, zen = 50.0;
+  const cv::Mat img = renderScene(cam, sunInLevelCamera(az, zen), false, true);
+  LalondeEstimator plain = make(LalondePrior::kZenith);
+  Expected<ImageSunEstimate> e = plain.estimate({img, cam, SunPrior{}});
+  ASSERT_TRUE(e);
+  EXPECT_TRUE(e->valid);
+  EXPECT_FALSE(plain.lastCues().sky_informative);
+  EXPECT_TRUE(plain.lastCues().shadow_informative);
+  // Either the sun or the mirrored sun (shadow lines have no sign).
+  EXPECT_LT(
+      std::min(azimuthErrorDeg(e->azimuth_deg, az), azimuthErrorDeg(e->azimuth_deg, az - 180.0)),
+      8.0);
+  const double plain_sigma = e->measurement.sigma;
+
+  LalondeEstimator vo = make(LalondePrior::kVisualOdometry);
+  // A VO prediction 25 deg off on the sun's side selects the true peak ...
+  SunPrior near{sunInLevelCamera(az - 25.0, zen + 10.0), Eigen::Vector3d(0.0, -1.0, 0.0)};
+  e = vo.estimate({img, cam, near});
+  ASSERT_TRUE(e);
+  EXPECT_LT(azimuthErrorDeg(e->azimuth_deg, az), 8.0);
+  EXPECT_LT(std::abs(e->zenith_deg - zen), 15.0);
+  EXPECT_LT(e->measurement.sigma, plain_sigma);  // the prior removed the second peak's mass
+  // ... and one on the other side selects the mirrored peak: the prior decides, not the image.
+  SunPrior far{sunInLevelCamera(az - 180.0 + 25.0, zen), Eigen::Vector3d(0.0, -1.0, 0.0)};
+  e = vo.estimate({img, cam, far});
+  ASSERT_TRUE(e);
+  EXPECT_LT(azimuthErrorDeg(e->azimuth_deg, az - 180.0), 8.0);
+}
+
+TEST(Lalonde, GrayImagesWork) {
+  LalondeEstimator est = make(LalondePrior::kZenith);
+  const StereoCamera cam = kittiCamera();
+  cv::Mat gray;
+  cv::cvtColor(renderScene(cam, sunInLevelCamera(30.0, 45.0), true, true), gray,
+               cv::COLOR_BGR2GRAY);
+  Expected<ImageSunEstimate> e = est.estimate({gray, cam, SunPrior{}});
+  ASSERT_TRUE(e);
+  expectFinite(*e);
+  EXPECT_TRUE(e->valid);
+  EXPECT_LT(azimuthErrorDeg(e->azimuth_deg, 30.0), 15.0);
+}
+
+TEST(Lalonde, DegenerateImagesAreInvalidNeverNaN) {
+  const StereoCamera cam = kittiCamera();
+  for (LalondePrior prior : {LalondePrior::kZenith, LalondePrior::kVisualOdometry}) {
+    LalondeEstimator est = make(prior);
+    const SunPrior p{sunInLevelCamera(10.0, 40.0), Eigen::Vector3d(0.0, -1.0, 0.0)};
+    for (int value : {0, 255}) {
+      const cv::Mat img(cam.height, cam.width, CV_8UC3, cv::Scalar::all(value));
+      Expected<ImageSunEstimate> e = est.estimate({img, cam, p});
+      ASSERT_TRUE(e) << e.status().toString();
+      EXPECT_FALSE(e->valid) << "uniform " << value;
+      expectFinite(*e);
+    }
+    // Sky only, no ground texture: the ground is uniform, the sky still counts.
+    Expected<ImageSunEstimate> e =
+        est.estimate({renderScene(cam, sunInLevelCamera(30.0, 45.0), true, false), cam, p});
+    ASSERT_TRUE(e);
+    EXPECT_TRUE(e->valid);
+    EXPECT_FALSE(est.lastCues().shadow_informative);
+  }
+}
+
+TEST(Lalonde, CuesCanBeSwitchedOff) {
+  const StereoCamera cam = kittiCamera();
+  const cv::Mat sky_only = renderScene(cam, sunInLevelCamera(30.0, 45.0), true, false);
+  LalondeOptions o;
+  o.use_sky = false;
+  LalondeEstimator est(o);
+  ASSERT_TRUE(est.init().isOk());
+  Expected<ImageSunEstimate> e = est.estimate({sky_only, cam, SunPrior{}});
+  ASSERT_TRUE(e);
+  EXPECT_FALSE(e->valid);  // the sky was the only cue
+  EXPECT_EQ(cv::countNonZero(est.lastCues().sky_loglik != 0.0), 0);
+}
+
+TEST(Lalonde, RejectsBadInput) {
+  const StereoCamera cam = kittiCamera();
+  LalondeEstimator uninitialised;
+  const cv::Mat img(cam.height, cam.width, CV_8UC3, cv::Scalar::all(100));
+  EXPECT_FALSE(uninitialised.estimate({img, cam, SunPrior{}}));
+
+  LalondeEstimator est = make(LalondePrior::kZenith);
+  EXPECT_FALSE(est.estimate({cv::Mat(cam.height, cam.width, CV_16UC1), cam, SunPrior{}}));
+  EXPECT_FALSE(est.estimate({cv::Mat(10, 10, CV_8UC3, cv::Scalar::all(1)), cam, SunPrior{}}));
+  EXPECT_FALSE(
+      est.estimate({img, cam, SunPrior{Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitZ()}}));
+
+  StereoCamera bad = cam;
+  bad.fu = 0.0;
+  EXPECT_FALSE(est.estimate({img, bad, SunPrior{}}));
+  StereoCamera mono = cam;  // only the intrinsics are needed
+  mono.baseline_m = 0.0;
+  EXPECT_TRUE(est.estimate({img, mono, SunPrior{}}));
+
+  LalondeEstimator vo = make(LalondePrior::kVisualOdometry);
+  Expected<ImageSunEstimate> e = vo.estimate({img, cam, std::nullopt});
+  ASSERT_FALSE(e);
+  EXPECT_NE(e.status().message().find("prior"), std::string::npos);
+  EXPECT_STREQ(vo.name(), "lalonde_vo");
+  EXPECT_STREQ(est.name(), "lalonde");
+}
+
+TEST(Lalonde, OptionsNameTheBadKey) {
+  LalondeOptions o;
+  EXPECT_TRUE(o.validate().isOk());
+  o.camera_height_m = -1.0;
+  EXPECT_NE(o.validate().message().find("lalonde.camera_height_m"), std::string::npos);
+  o = LalondeOptions{};
+  o.canny_high = o.canny_low - 1.0;
+  EXPECT_NE(o.validate().message().find("lalonde.canny_high"), std::string::npos);
+  o = LalondeOptions{};
+  o.vo_sigma_azimuth_deg = 0.0;
+  EXPECT_NE(o.validate().message().find("lalonde.vo_sigma_azimuth_deg"), std::string::npos);
+  LalondeEstimator e(o);
+  EXPECT_FALSE(e.init().isOk());
+}
+
+}  // namespace
+}  // namespace sunvo::sunvision
