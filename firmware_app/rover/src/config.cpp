@@ -150,9 +150,11 @@ Status readEnum(Reader& r, const YAML::Node& map, const std::string& prefix, con
 
 const std::vector<std::string> kSourceNames = {"kitti", "v4l2"};
 const std::vector<std::string> kTriggerNames = {"simulated", "gpio"};
+const std::vector<std::string> kLayoutNames = {"two_devices", "side_by_side"};
+const std::vector<std::string> kPixelFormatNames = {"grey", "yuyv"};
 const std::vector<std::string> kEndNames = {"stop", "hold", "loop", "pingpong"};
 const std::vector<std::string> kWorldNames = {"oxts", "config"};
-const std::vector<std::string> kSunNames = {"none", "csv"};
+const std::vector<std::string> kSunNames = {"none", "csv", "lalonde", "lalonde_vo", "sun_cnn"};
 
 Status readThread(Reader& r, const YAML::Node& threads, const char* name,
                   runtime::ThreadPolicy* p) {
@@ -181,6 +183,13 @@ Status readAll(Reader& r, const YAML::Node& root, RoverConfig* c) {
   SUNVO_RETURN_IF_ERROR(r.get(m, "source.v4l2", "left_device", &c->source.v4l2.left_device));
   SUNVO_RETURN_IF_ERROR(r.get(m, "source.v4l2", "right_device", &c->source.v4l2.right_device));
   SUNVO_RETURN_IF_ERROR(r.get(m, "source.v4l2", "calibration", &c->source.v4l2.calibration));
+  SUNVO_RETURN_IF_ERROR(
+      readEnum(r, m, "source.v4l2", "layout", kLayoutNames, &c->source.v4l2.layout));
+  SUNVO_RETURN_IF_ERROR(readEnum(r, m, "source.v4l2", "pixel_format", kPixelFormatNames,
+                                 &c->source.v4l2.pixel_format));
+  SUNVO_RETURN_IF_ERROR(r.get(m, "source.v4l2", "buffer_count", &c->source.v4l2.buffer_count));
+  SUNVO_RETURN_IF_ERROR(
+      r.get(m, "source.v4l2", "dequeue_timeout_ms", &c->source.v4l2.dequeue_timeout_ms));
   // trigger
   SUNVO_RETURN_IF_ERROR(r.section(root, "", "trigger", &n));
   TriggerConfig& t = c->trigger;
@@ -190,6 +199,8 @@ Status readAll(Reader& r, const YAML::Node& root, RoverConfig* c) {
   SUNVO_RETURN_IF_ERROR(r.get(n, "trigger", "timeout_factor", &t.timeout_factor));
   SUNVO_RETURN_IF_ERROR(r.get(n, "trigger", "gpio_chip", &t.gpio_chip));
   SUNVO_RETURN_IF_ERROR(r.get(n, "trigger", "gpio_line", &t.gpio_line));
+  SUNVO_RETURN_IF_ERROR(r.get(n, "trigger", "frame_delay_ms", &t.frame_delay_ms));
+  SUNVO_RETURN_IF_ERROR(r.get(n, "trigger", "match_window_ms", &t.match_window_ms));
   // frames
   SUNVO_RETURN_IF_ERROR(r.section(root, "", "frames", &n));
   SUNVO_RETURN_IF_ERROR(r.get(n, "frames", "width", &c->frames.width));
@@ -229,6 +240,7 @@ Status readAll(Reader& r, const YAML::Node& root, RoverConfig* c) {
   SUNVO_RETURN_IF_ERROR(readEnum(r, n, "sun", "provider", kSunNames, &s.provider));
   SUNVO_RETURN_IF_ERROR(r.get(n, "sun", "every_n_frames", &s.every_n_frames));
   SUNVO_RETURN_IF_ERROR(r.get(n, "sun", "csv", &s.csv));
+  SUNVO_RETURN_IF_ERROR(r.get(n, "sun", "model", &s.model));
   SUNVO_RETURN_IF_ERROR(r.get(n, "sun", "sigma", &s.sigma));
   SUNVO_RETURN_IF_ERROR(r.get(n, "sun", "wait_ms", &s.wait_ms));
   SUNVO_RETURN_IF_ERROR(r.get(n, "sun", "estimate_base_attitude", &s.estimate_base_attitude));
@@ -290,12 +302,23 @@ Status RoverConfig::validate() const {
     }
     if (k.total_frames < 0) return outside("source.kitti.total_frames", k.total_frames, "[0, inf)");
   }
-  if (source.type == SourceType::kV4l2 || trigger.type == TriggerType::kGpio) {
-    return invalidArgument(
-        std::string(source.type == SourceType::kV4l2 ? "source.type: v4l2" : "trigger.type: gpio") +
-        " is not wired into this build yet (drivers/v4l2, drivers/gpio)");
+  if (source.type == SourceType::kV4l2) {
+    if (source.v4l2.calibration.empty()) return invalidArgument("source.v4l2.calibration: empty");
+    SUNVO_RETURN_IF_ERROR(checkRange("source.v4l2.buffer_count", source.v4l2.buffer_count, 2, 32));
+    SUNVO_RETURN_IF_ERROR(
+        checkRange("source.v4l2.dequeue_timeout_ms", source.v4l2.dequeue_timeout_ms, 1, 60000));
+    if (trigger.type != TriggerType::kGpio) {
+      return invalidArgument("trigger.type: source.type v4l2 needs trigger.type gpio");
+    }
+  }
+  if (trigger.type == TriggerType::kGpio && source.type != SourceType::kV4l2) {
+    return invalidArgument("trigger.type: gpio needs source.type v4l2");
   }
   SUNVO_RETURN_IF_ERROR(checkOpenLow("trigger.rate_hz", trigger.rate_hz, 0.0, 200.0));
+  SUNVO_RETURN_IF_ERROR(
+      checkRange("trigger.frame_delay_ms", trigger.frame_delay_ms, -1000.0, 1000.0));
+  SUNVO_RETURN_IF_ERROR(
+      checkRange("trigger.match_window_ms", trigger.match_window_ms, 0.0, 500.0 / trigger.rate_hz));
   SUNVO_RETURN_IF_ERROR(checkRange("trigger.timeout_factor", trigger.timeout_factor, 1.5, 100.0));
   SUNVO_RETURN_IF_ERROR(checkRange("trigger.gpio_line", trigger.gpio_line, 0, 1023));
   SUNVO_RETURN_IF_ERROR(frames.validate());
@@ -335,6 +358,16 @@ Status RoverConfig::validate() const {
   SUNVO_RETURN_IF_ERROR(checkRange("sun.max_cosine_distance", sun.max_cosine_distance, 0, 2));
   if (sun.provider == SunProviderType::kCsv && sun.csv.empty()) {
     return invalidArgument("sun.csv: empty, but sun.provider is csv");
+  }
+  const bool image_provider = sun.provider == SunProviderType::kLalonde ||
+                              sun.provider == SunProviderType::kLalondeVo ||
+                              sun.provider == SunProviderType::kSunCnn;
+  if (image_provider && source.type == SourceType::kV4l2) {
+    return invalidArgument("sun.provider: " + kSunNames[static_cast<std::size_t>(sun.provider)] +
+                           " needs the left colour image; source.type: v4l2 delivers gray");
+  }
+  if (sun.provider == SunProviderType::kSunCnn && sun.model.empty()) {
+    return invalidArgument("sun.model: empty, but sun.provider is sun_cnn");
   }
   SUNVO_RETURN_IF_ERROR(
       checkRange("serial.tx_buffer_bytes", serial.tx_buffer_bytes, 1024, 1048576));
