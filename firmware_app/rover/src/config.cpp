@@ -396,13 +396,24 @@ Status RoverConfig::validate() const {
 std::string RoverConfig::describe() const {
   std::ostringstream o;
   o << "config " << path << ":\n"
-    << "  source: " << kSourceNames[static_cast<std::size_t>(source.type)]
-    << " drive_dir=" << source.kitti.drive_dir << " preload=" << source.kitti.preload << " frames=["
-    << source.kitti.first_frame << ", " << source.kitti.last_frame << "]"
-    << " end=" << kEndNames[static_cast<std::size_t>(source.kitti.end)]
-    << " total_frames=" << source.kitti.total_frames << "\n"
-    << "  trigger: " << kTriggerNames[static_cast<std::size_t>(trigger.type)]
-    << " rate_hz=" << trigger.rate_hz << " follow_recording=" << trigger.follow_recording << "\n"
+    << "  source: " << kSourceNames[static_cast<std::size_t>(source.type)];
+  if (source.type == SourceType::kV4l2) {
+    const V4l2SourceConfig& v = source.v4l2;
+    o << " " << kLayoutNames[static_cast<std::size_t>(v.layout)] << " " << v.left_device << " "
+      << v.right_device << " " << kPixelFormatNames[static_cast<std::size_t>(v.pixel_format)]
+      << " buffers=" << v.buffer_count << " calibration=" << v.calibration << "\n";
+  } else {
+    o << " drive_dir=" << source.kitti.drive_dir << " preload=" << source.kitti.preload
+      << " frames=[" << source.kitti.first_frame << ", " << source.kitti.last_frame << "]"
+      << " end=" << kEndNames[static_cast<std::size_t>(source.kitti.end)]
+      << " total_frames=" << source.kitti.total_frames << "\n";
+  }
+  o << "  trigger: " << kTriggerNames[static_cast<std::size_t>(trigger.type)]
+    << " rate_hz=" << trigger.rate_hz << " follow_recording=" << trigger.follow_recording
+    << (trigger.type == TriggerType::kGpio
+            ? " strobe=" + trigger.gpio_chip + ":" + std::to_string(trigger.gpio_line)
+            : std::string())
+    << "\n"
     << "  frames: " << frames.width << "x" << frames.height << " pool_depth=" << frames.depth
     << "; queues: frames=" << queues.frames << " sun_requests=" << queues.sun_requests
     << " sun_results=" << queues.sun_results << " poses=" << queues.poses << "\n"
