@@ -6,6 +6,7 @@
 #include <set>
 #include <sstream>
 
+#include "sunvo/rover/sun_provider.hpp"
 #include "sunvo/runtime/spsc_queue.hpp"
 
 namespace sunvo::rover {
@@ -359,10 +360,7 @@ Status RoverConfig::validate() const {
   if (sun.provider == SunProviderType::kCsv && sun.csv.empty()) {
     return invalidArgument("sun.csv: empty, but sun.provider is csv");
   }
-  const bool image_provider = sun.provider == SunProviderType::kLalonde ||
-                              sun.provider == SunProviderType::kLalondeVo ||
-                              sun.provider == SunProviderType::kSunCnn;
-  if (image_provider && source.type == SourceType::kV4l2) {
+  if (sunProviderNeedsImages(sun.provider) && source.type == SourceType::kV4l2) {
     return invalidArgument("sun.provider: " + kSunNames[static_cast<std::size_t>(sun.provider)] +
                            " needs the left colour image; source.type: v4l2 delivers gray");
   }
