@@ -110,7 +110,8 @@ int main(int argc, char** argv) {
     }
     link = std::move(*l);
   }
-  auto app = sunvo::rover::RoverApp::create(*config, std::move(link));
+  auto app =
+      sunvo::rover::RoverApp::create(*config, std::move(link), sunvo::rover::productionDevices());
   if (!app) {
     std::fprintf(stderr, "sunvo_rover: %s\n", app.status().message().c_str());
     return app.status().code() == sunvo::StatusCode::kInvalidArgument ? 2 : 1;

@@ -33,11 +33,22 @@ TEST(RoverConfig, TheShippedConfigsLoad) {
   EXPECT_EQ(replay->source.kitti.end, EndAction::kHold);
   EXPECT_EQ(replay->frames.width, 1242);
   EXPECT_EQ(replay->rt.capture.fifo_priority, 80);
-  // The deployment file parses; it names the drivers that are not wired yet.
+  // The deployment file: V4L2 pair with the GPIO strobe; an image sun provider is refused there
+  // (the V4L2 source delivers gray), naming the key.
   auto rover = loadRoverConfig(std::string(SUNVO_SOURCE_DIR) + "/config/rover.yaml");
-  ASSERT_FALSE(rover);
-  EXPECT_NE(rover.status().message().find("source.type: v4l2"), std::string::npos)
-      << rover.status().message();
+  ASSERT_TRUE(rover) << rover.status().toString();
+  EXPECT_EQ(rover->source.type, SourceType::kV4l2);
+  EXPECT_EQ(rover->trigger.type, TriggerType::kGpio);
+  EXPECT_EQ(rover->sun.model, "/etc/sunvo/sun_cnn.onnx");
+  auto gray = loadRoverConfig(std::string(SUNVO_SOURCE_DIR) + "/config/rover.yaml",
+                              {{"sun.provider", "sun_cnn"}});
+  ASSERT_FALSE(gray);
+  EXPECT_NE(gray.status().message().find("sun.provider: sun_cnn"), std::string::npos)
+      << gray.status().message();
+  auto no_gpio = loadRoverConfig(std::string(SUNVO_SOURCE_DIR) + "/config/rover.yaml",
+                                 {{"trigger.type", "simulated"}});
+  ASSERT_FALSE(no_gpio);
+  EXPECT_NE(no_gpio.status().message().find("trigger.type"), std::string::npos);
 }
 
 TEST(RoverConfig, DefaultsAndOverrides) {

@@ -67,11 +67,17 @@ double jsonNumber(const std::string& json, const std::string& key) {
   return std::atof(m[1].str().c_str());
 }
 
-TEST(RoverReplay, WholeProgramIntoAPseudoTerminal) {
-  int frames = 0;
-  const std::string drive = findOrRenderDrive(&frames);
-  ASSERT_FALSE(drive.empty()) << "no rendered drive";
-  const fs::path out = fs::path(SUNVO_BINARY_DIR) / "test_out" / "rover_replay";
+struct ProgramRun {
+  int rc = -1;
+  std::string json;  // sunvo_pose_reader's evaluation
+  std::string log;   // sunvo_rover's output (start-up lines and the final summary)
+};
+
+// sunvo_pose_reader runs sunvo_rover (config/rover_replay.yaml on `drive`, extra --set options
+// appended) into a pty and evaluates what arrives; everything goes to test_out/<name>.
+ProgramRun runProgram(const std::string& drive, int frames, const std::string& name,
+                      const std::string& extra_sets) {
+  const fs::path out = fs::path(SUNVO_BINARY_DIR) / "test_out" / name;
   fs::remove_all(out);
   fs::create_directories(out);
   const std::string emu = SUNVO_TOOL_EMULATOR;
@@ -85,13 +91,27 @@ TEST(RoverReplay, WholeProgramIntoAPseudoTerminal) {
       "/config/rover_replay.yaml --set source.kitti.drive_dir=" + drive +
       " --set sun.csv=" + drive +
       "/gt/sun_cam0.csv --set serial.device={pty} --set profiling.output_dir=" + out.string() +
-      " > " + (out / "reader.txt").string() + " 2>&1";
-  const int rc = std::system(cmd.c_str());
+      extra_sets + " > " + (out / "reader.txt").string() + " 2>&1";
+  ProgramRun run;
+  run.rc = std::system(cmd.c_str());
   std::stringstream json_text, log_text;
   json_text << std::ifstream(out / "reader.json").rdbuf();
   log_text << std::ifstream(out / "rover.log").rdbuf();
-  const std::string json = json_text.str();
-  std::printf("%s\n%s\n", log_text.str().c_str(), json.c_str());
+  run.json = json_text.str();
+  run.log = log_text.str();
+  std::printf("%s\n%s\n", run.log.c_str(), run.json.c_str());
+  return run;
+}
+
+TEST(RoverReplay, WholeProgramIntoAPseudoTerminal) {
+  int frames = 0;
+  const std::string drive = findOrRenderDrive(&frames);
+  ASSERT_FALSE(drive.empty()) << "no rendered drive";
+  const fs::path out = fs::path(SUNVO_BINARY_DIR) / "test_out" / "rover_replay";
+  const ProgramRun run = runProgram(drive, frames, "rover_replay", "");
+  const int rc = run.rc;
+  const std::string& json = run.json;
+  std::stringstream log_text(run.log);
   EXPECT_EQ(rc, 0);
   // Every pose arrived once, CRCs good, clean shutdown on SIGTERM with the summary.
   EXPECT_EQ(jsonNumber(json, "odometry_received"), frames);
@@ -126,6 +146,30 @@ TEST(RoverReplay, WholeProgramIntoAPseudoTerminal) {
   EXPECT_LT(std::abs(drift_rover - ev->table1.final_drift_m),
             0.02 + 0.5 * ev->table1.final_drift_m);
   EXPECT_LT(rot_rover, 2.0 * ev->table1.rot_armse_rad + 1e-3);
+}
+
+// sun.provider: sun_cnn with the repo's model: the program starts, the KITTI source delivers the
+// left colour image, and the sun thread runs the CNN on every fifth frame (frames 5, 10, ...),
+// each call answered without error, while every pose still arrives.
+TEST(RoverReplay, SunCnnProviderEveryFifthFrame) {
+  int frames = 0;
+  const std::string drive = findOrRenderDrive(&frames);
+  ASSERT_FALSE(drive.empty()) << "no rendered drive";
+  const ProgramRun run = runProgram(drive, frames, "rover_sun_cnn",
+                                    std::string(" --set sun.provider=sun_cnn --set sun.model=") +
+                                        SUNVO_SOURCE_DIR + "/config/sun_cnn.onnx");
+  EXPECT_EQ(run.rc, 0);
+  EXPECT_EQ(jsonNumber(run.json, "odometry_received"), frames);
+  const std::regex re(
+      "sun \\(sun_cnn\\): requests ([0-9]+), measurements ([0-9]+), errors ([0-9]+)");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(run.log, m, re)) << run.log;
+  const int expected_calls = (frames - 1) / 5;  // sequences 5, 10, ... below frames
+  EXPECT_EQ(std::atoi(m[1].str().c_str()), expected_calls);
+  EXPECT_EQ(std::atoi(m[3].str().c_str()), 0);  // no call lacked its colour image or failed
+  const std::regex results("queue sun_results +cap [0-9]+: pushed ([0-9]+)");
+  ASSERT_TRUE(std::regex_search(run.log, m, results)) << run.log;
+  EXPECT_EQ(std::atoi(m[1].str().c_str()), expected_calls);  // every call answered
 }
 
 }  // namespace

@@ -1,6 +1,8 @@
 #include "sunvo/rover/app.hpp"
 
 #include <algorithm>
+#include <array>
+#include <atomic>
 #include <cinttypes>
 #include <cmath>
 #include <cstdarg>
@@ -13,6 +15,7 @@
 #include "sunvo/kitti/calibration.hpp"
 #include "sunvo/kitti/oxts.hpp"
 #include "sunvo/pipeline/stereo_visual_odometry.hpp"
+#include "sunvo/rover/device_sources.hpp"
 #include "sunvo/runtime/allocation_meter.hpp"
 #include "sunvo/runtime/clock.hpp"
 #include "sunvo/runtime/deadline.hpp"
@@ -142,6 +145,12 @@ struct RoverApp::Impl {
   std::unique_ptr<FrameSource> source;
   std::shared_ptr<const ReplaySchedule> schedule;
   std::unique_ptr<SunProvider> sun_provider;
+  // The latest camera attitude q_w_c (w, x, y, z) for the image estimators' prior, written by the
+  // estimator thread, read by the sun thread: a seqlock (odd = being written), no allocation.
+  std::atomic<std::uint64_t> attitude_seq{0};
+  std::array<std::atomic<double>, 4> q_w_c{};
+  void publishAttitude(const Eigen::Quaterniond& q);
+  bool latestAttitude(Eigen::Quaterniond* q) const;
   std::unique_ptr<PoseLink> link;
   WorldSetup world;
   StereoCamera camera;
@@ -409,6 +418,7 @@ void RoverApp::Impl::estimatorLoop() {
     health.frames_processed.fetch_add(1, std::memory_order_relaxed);
     have_prev = true;
     T_w_prev = T_w_c;
+    if (sun_provider) publishAttitude(q);
     t_prev_ns = utc;
     last_status = status;
     estimator_meter.frameDone();
@@ -442,6 +452,16 @@ void RoverApp::Impl::sunLoop() {
     query.source_index = req.source_index;
     query.utc_ns = req.utc_ns;
     if (req.image_slot != kNoImage) query.images = &sun_pool->slot(req.image_slot).frame;
+    Eigen::Quaterniond q_w_c_now;
+    if (sp && latestAttitude(&q_w_c_now)) {
+      // Prior in the camera: sun_c = R_c_w sun_w, up_c = R_c_w (0, 0, 1) with ENU world (z up).
+      // The attitude is the last published pose's, one or a few frames before this one.
+      const Eigen::Matrix3d R_c_w = q_w_c_now.toRotationMatrix().transpose();
+      sunfusion::SunPrior prior;
+      prior.sun_c = (R_c_w * sp->sun_enu).normalized();
+      prior.up_c = R_c_w * Eigen::Vector3d::UnitZ();
+      query.prior = prior;
+    }
     auto m = sun_provider->measure(query);
     if (req.image_slot != kNoImage) sun_pool->release(req.image_slot);
     if (!sp || !m) {
@@ -463,6 +483,34 @@ void RoverApp::Impl::sunLoop() {
     sun_meter.frameDone();
   }
   sun_done.store(true, std::memory_order_release);
+}
+
+void RoverApp::Impl::publishAttitude(const Eigen::Quaterniond& q) {
+  const std::uint64_t s0 = attitude_seq.load(std::memory_order_relaxed);
+  attitude_seq.store(s0 + 1, std::memory_order_relaxed);
+  std::atomic_thread_fence(std::memory_order_release);
+  q_w_c[0].store(q.w(), std::memory_order_relaxed);
+  q_w_c[1].store(q.x(), std::memory_order_relaxed);
+  q_w_c[2].store(q.y(), std::memory_order_relaxed);
+  q_w_c[3].store(q.z(), std::memory_order_relaxed);
+  attitude_seq.store(s0 + 2, std::memory_order_release);
+}
+
+bool RoverApp::Impl::latestAttitude(Eigen::Quaterniond* q) const {
+  for (int attempt = 0; attempt < 8; ++attempt) {
+    const std::uint64_t s0 = attitude_seq.load(std::memory_order_acquire);
+    if (s0 == 0) return false;  // no pose yet
+    if (s0 & 1U) continue;      // being written
+    const double w = q_w_c[0].load(std::memory_order_relaxed);
+    const double x = q_w_c[1].load(std::memory_order_relaxed);
+    const double y = q_w_c[2].load(std::memory_order_relaxed);
+    const double z = q_w_c[3].load(std::memory_order_relaxed);
+    std::atomic_thread_fence(std::memory_order_acquire);
+    if (attitude_seq.load(std::memory_order_relaxed) != s0) continue;
+    *q = Eigen::Quaterniond(w, x, y, z);
+    return std::isfinite(q->norm()) && q->norm() > 0.5;
+  }
+  return false;
 }
 
 void RoverApp::Impl::telemetryLoop() {
@@ -523,17 +571,23 @@ void RoverApp::Impl::telemetryLoop() {
   telemetry_done.store(true, std::memory_order_release);
 }
 
+RoverDevices productionDevices() {
+  return RoverDevices{&sysio::linuxSysIo(), &gpio::libgpiodApi()};
+}
+
 Expected<std::unique_ptr<RoverApp>> RoverApp::create(const RoverConfig& config,
-                                                     std::unique_ptr<PoseLink> link) {
+                                                     std::unique_ptr<PoseLink> link,
+                                                     const RoverDevices& devices) {
   SUNVO_RETURN_IF_ERROR(config.validate());
   auto impl = std::make_unique<Impl>(config);
   impl->period_ns = static_cast<TimeNs>(1e9 / config.trigger.rate_hz);
   impl->link = std::move(link);
 
-  // Source and trigger (the V4L2 and GPIO drivers are wired in here once they land).
+  // Source and trigger.
+  const bool needs_images = sunProviderNeedsImages(config.sun.provider);
   const KittiReplaySource* kitti_source = nullptr;
   if (config.source.type == SourceType::kKitti) {
-    auto src = KittiReplaySource::open(config.source.kitti);
+    auto src = KittiReplaySource::open(config.source.kitti, needs_images);
     if (!src) return Status(src.status().code(), "source.kitti: " + src.status().message());
     const KittiSourceConfig& k = config.source.kitti;
     impl->schedule =
@@ -542,6 +596,26 @@ Expected<std::unique_ptr<RoverApp>> RoverApp::create(const RoverConfig& config,
     (*src)->setSchedule(impl->schedule);
     kitti_source = src->get();
     impl->source = std::move(*src);
+  }
+  // UTC of a monotonic stamp (strobe edges, V4L2 buffers): t_utc = t_mono + (UTC - monotonic),
+  // the offset taken once here (the middle of two monotonic reads around the UTC read).
+  const TimeNs mono_before = runtime::monotonicNs();
+  const TimeNs utc_now = runtime::utcNowNs();
+  const TimeNs mono_after = runtime::monotonicNs();
+  const TimeNs utc_minus_mono_ns = utc_now - (mono_before + (mono_after - mono_before) / 2);
+  if (config.source.type == SourceType::kV4l2) {
+    if (devices.io == nullptr) return invalidArgument("source.type: v4l2 needs a SysIo");
+    auto src = V4l2FrameSource::open(config, *devices.io, utc_minus_mono_ns);
+    if (!src) return src.status();
+    impl->source = std::move(*src);
+  }
+  if (config.trigger.type == TriggerType::kGpio) {
+    if (devices.gpio == nullptr) return invalidArgument("trigger.type: gpio needs a GpioApi");
+    const auto wait_ns =
+        static_cast<TimeNs>(config.trigger.timeout_factor * static_cast<double>(impl->period_ns));
+    auto trig = StrobeTrigger::open(config.trigger, wait_ns, *devices.gpio, utc_minus_mono_ns);
+    if (!trig) return trig.status();
+    impl->trigger = std::move(*trig);
   }
   if (config.trigger.type == TriggerType::kSimulated) {
     if (!impl->schedule) return invalidArgument("trigger.type: simulated needs a replay source");
@@ -561,7 +635,9 @@ Expected<std::unique_ptr<RoverApp>> RoverApp::create(const RoverConfig& config,
   if (!world) return world.status();
   impl->world = *world;
 
-  auto pool = runtime::FramePool::create(config.frames);
+  runtime::FramePoolOptions frame_options = config.frames;
+  frame_options.color = needs_images;  // the capture thread copies left_color for the provider
+  auto pool = runtime::FramePool::create(frame_options);
   if (!pool) return pool.status();
   impl->pool = std::move(*pool);
 

@@ -6,6 +6,7 @@
 #include <set>
 #include <sstream>
 
+#include "sunvo/rover/sun_provider.hpp"
 #include "sunvo/runtime/spsc_queue.hpp"
 
 namespace sunvo::rover {
@@ -150,9 +151,11 @@ Status readEnum(Reader& r, const YAML::Node& map, const std::string& prefix, con
 
 const std::vector<std::string> kSourceNames = {"kitti", "v4l2"};
 const std::vector<std::string> kTriggerNames = {"simulated", "gpio"};
+const std::vector<std::string> kLayoutNames = {"two_devices", "side_by_side"};
+const std::vector<std::string> kPixelFormatNames = {"grey", "yuyv"};
 const std::vector<std::string> kEndNames = {"stop", "hold", "loop", "pingpong"};
 const std::vector<std::string> kWorldNames = {"oxts", "config"};
-const std::vector<std::string> kSunNames = {"none", "csv"};
+const std::vector<std::string> kSunNames = {"none", "csv", "lalonde", "lalonde_vo", "sun_cnn"};
 
 Status readThread(Reader& r, const YAML::Node& threads, const char* name,
                   runtime::ThreadPolicy* p) {
@@ -181,6 +184,13 @@ Status readAll(Reader& r, const YAML::Node& root, RoverConfig* c) {
   SUNVO_RETURN_IF_ERROR(r.get(m, "source.v4l2", "left_device", &c->source.v4l2.left_device));
   SUNVO_RETURN_IF_ERROR(r.get(m, "source.v4l2", "right_device", &c->source.v4l2.right_device));
   SUNVO_RETURN_IF_ERROR(r.get(m, "source.v4l2", "calibration", &c->source.v4l2.calibration));
+  SUNVO_RETURN_IF_ERROR(
+      readEnum(r, m, "source.v4l2", "layout", kLayoutNames, &c->source.v4l2.layout));
+  SUNVO_RETURN_IF_ERROR(readEnum(r, m, "source.v4l2", "pixel_format", kPixelFormatNames,
+                                 &c->source.v4l2.pixel_format));
+  SUNVO_RETURN_IF_ERROR(r.get(m, "source.v4l2", "buffer_count", &c->source.v4l2.buffer_count));
+  SUNVO_RETURN_IF_ERROR(
+      r.get(m, "source.v4l2", "dequeue_timeout_ms", &c->source.v4l2.dequeue_timeout_ms));
   // trigger
   SUNVO_RETURN_IF_ERROR(r.section(root, "", "trigger", &n));
   TriggerConfig& t = c->trigger;
@@ -190,6 +200,8 @@ Status readAll(Reader& r, const YAML::Node& root, RoverConfig* c) {
   SUNVO_RETURN_IF_ERROR(r.get(n, "trigger", "timeout_factor", &t.timeout_factor));
   SUNVO_RETURN_IF_ERROR(r.get(n, "trigger", "gpio_chip", &t.gpio_chip));
   SUNVO_RETURN_IF_ERROR(r.get(n, "trigger", "gpio_line", &t.gpio_line));
+  SUNVO_RETURN_IF_ERROR(r.get(n, "trigger", "frame_delay_ms", &t.frame_delay_ms));
+  SUNVO_RETURN_IF_ERROR(r.get(n, "trigger", "match_window_ms", &t.match_window_ms));
   // frames
   SUNVO_RETURN_IF_ERROR(r.section(root, "", "frames", &n));
   SUNVO_RETURN_IF_ERROR(r.get(n, "frames", "width", &c->frames.width));
@@ -229,6 +241,7 @@ Status readAll(Reader& r, const YAML::Node& root, RoverConfig* c) {
   SUNVO_RETURN_IF_ERROR(readEnum(r, n, "sun", "provider", kSunNames, &s.provider));
   SUNVO_RETURN_IF_ERROR(r.get(n, "sun", "every_n_frames", &s.every_n_frames));
   SUNVO_RETURN_IF_ERROR(r.get(n, "sun", "csv", &s.csv));
+  SUNVO_RETURN_IF_ERROR(r.get(n, "sun", "model", &s.model));
   SUNVO_RETURN_IF_ERROR(r.get(n, "sun", "sigma", &s.sigma));
   SUNVO_RETURN_IF_ERROR(r.get(n, "sun", "wait_ms", &s.wait_ms));
   SUNVO_RETURN_IF_ERROR(r.get(n, "sun", "estimate_base_attitude", &s.estimate_base_attitude));
@@ -290,12 +303,23 @@ Status RoverConfig::validate() const {
     }
     if (k.total_frames < 0) return outside("source.kitti.total_frames", k.total_frames, "[0, inf)");
   }
-  if (source.type == SourceType::kV4l2 || trigger.type == TriggerType::kGpio) {
-    return invalidArgument(
-        std::string(source.type == SourceType::kV4l2 ? "source.type: v4l2" : "trigger.type: gpio") +
-        " is not wired into this build yet (drivers/v4l2, drivers/gpio)");
+  if (source.type == SourceType::kV4l2) {
+    if (source.v4l2.calibration.empty()) return invalidArgument("source.v4l2.calibration: empty");
+    SUNVO_RETURN_IF_ERROR(checkRange("source.v4l2.buffer_count", source.v4l2.buffer_count, 2, 32));
+    SUNVO_RETURN_IF_ERROR(
+        checkRange("source.v4l2.dequeue_timeout_ms", source.v4l2.dequeue_timeout_ms, 1, 60000));
+    if (trigger.type != TriggerType::kGpio) {
+      return invalidArgument("trigger.type: source.type v4l2 needs trigger.type gpio");
+    }
+  }
+  if (trigger.type == TriggerType::kGpio && source.type != SourceType::kV4l2) {
+    return invalidArgument("trigger.type: gpio needs source.type v4l2");
   }
   SUNVO_RETURN_IF_ERROR(checkOpenLow("trigger.rate_hz", trigger.rate_hz, 0.0, 200.0));
+  SUNVO_RETURN_IF_ERROR(
+      checkRange("trigger.frame_delay_ms", trigger.frame_delay_ms, -1000.0, 1000.0));
+  SUNVO_RETURN_IF_ERROR(
+      checkRange("trigger.match_window_ms", trigger.match_window_ms, 0.0, 500.0 / trigger.rate_hz));
   SUNVO_RETURN_IF_ERROR(checkRange("trigger.timeout_factor", trigger.timeout_factor, 1.5, 100.0));
   SUNVO_RETURN_IF_ERROR(checkRange("trigger.gpio_line", trigger.gpio_line, 0, 1023));
   SUNVO_RETURN_IF_ERROR(frames.validate());
@@ -336,6 +360,13 @@ Status RoverConfig::validate() const {
   if (sun.provider == SunProviderType::kCsv && sun.csv.empty()) {
     return invalidArgument("sun.csv: empty, but sun.provider is csv");
   }
+  if (sunProviderNeedsImages(sun.provider) && source.type == SourceType::kV4l2) {
+    return invalidArgument("sun.provider: " + kSunNames[static_cast<std::size_t>(sun.provider)] +
+                           " needs the left colour image; source.type: v4l2 delivers gray");
+  }
+  if (sun.provider == SunProviderType::kSunCnn && sun.model.empty()) {
+    return invalidArgument("sun.model: empty, but sun.provider is sun_cnn");
+  }
   SUNVO_RETURN_IF_ERROR(
       checkRange("serial.tx_buffer_bytes", serial.tx_buffer_bytes, 1024, 1048576));
   SUNVO_RETURN_IF_ERROR(checkOpenLow("telemetry.heartbeat_hz", telemetry.heartbeat_hz, 0.0, 50.0));
@@ -363,13 +394,24 @@ Status RoverConfig::validate() const {
 std::string RoverConfig::describe() const {
   std::ostringstream o;
   o << "config " << path << ":\n"
-    << "  source: " << kSourceNames[static_cast<std::size_t>(source.type)]
-    << " drive_dir=" << source.kitti.drive_dir << " preload=" << source.kitti.preload << " frames=["
-    << source.kitti.first_frame << ", " << source.kitti.last_frame << "]"
-    << " end=" << kEndNames[static_cast<std::size_t>(source.kitti.end)]
-    << " total_frames=" << source.kitti.total_frames << "\n"
-    << "  trigger: " << kTriggerNames[static_cast<std::size_t>(trigger.type)]
-    << " rate_hz=" << trigger.rate_hz << " follow_recording=" << trigger.follow_recording << "\n"
+    << "  source: " << kSourceNames[static_cast<std::size_t>(source.type)];
+  if (source.type == SourceType::kV4l2) {
+    const V4l2SourceConfig& v = source.v4l2;
+    o << " " << kLayoutNames[static_cast<std::size_t>(v.layout)] << " " << v.left_device << " "
+      << v.right_device << " " << kPixelFormatNames[static_cast<std::size_t>(v.pixel_format)]
+      << " buffers=" << v.buffer_count << " calibration=" << v.calibration << "\n";
+  } else {
+    o << " drive_dir=" << source.kitti.drive_dir << " preload=" << source.kitti.preload
+      << " frames=[" << source.kitti.first_frame << ", " << source.kitti.last_frame << "]"
+      << " end=" << kEndNames[static_cast<std::size_t>(source.kitti.end)]
+      << " total_frames=" << source.kitti.total_frames << "\n";
+  }
+  o << "  trigger: " << kTriggerNames[static_cast<std::size_t>(trigger.type)]
+    << " rate_hz=" << trigger.rate_hz << " follow_recording=" << trigger.follow_recording
+    << (trigger.type == TriggerType::kGpio
+            ? " strobe=" + trigger.gpio_chip + ":" + std::to_string(trigger.gpio_line)
+            : std::string())
+    << "\n"
     << "  frames: " << frames.width << "x" << frames.height << " pool_depth=" << frames.depth
     << "; queues: frames=" << queues.frames << " sun_requests=" << queues.sun_requests
     << " sun_results=" << queues.sun_results << " poses=" << queues.poses << "\n"

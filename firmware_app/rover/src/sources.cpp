@@ -81,7 +81,7 @@ Status SimulatedTrigger::wait(TimeNs timeout_ns, TriggerEvent* out) {
 }
 
 Expected<std::unique_ptr<KittiReplaySource>> KittiReplaySource::open(
-    const KittiSourceConfig& config) {
+    const KittiSourceConfig& config, bool color) {
   if (!config.preload && (config.end == EndAction::kLoop || config.end == EndAction::kPingPong)) {
     return invalidArgument("source.kitti.end: loop and pingpong need source.kitti.preload: true");
   }
@@ -91,6 +91,7 @@ Expected<std::unique_ptr<KittiReplaySource>> KittiReplaySource::open(
   o.utc_offset_s = config.utc_offset_s;
   o.first_frame = config.first_frame;
   o.last_frame = config.last_frame;
+  o.use_color = color;
   std::unique_ptr<KittiReplaySource> src(new KittiReplaySource());
   src->config_ = config;
   auto live = kitti::KittiStereoSource::open(o);
@@ -124,6 +125,9 @@ Status KittiReplaySource::grab(const TriggerEvent& trigger, runtime::FrameSlot& 
     }
     src.left.copyTo(dst.left);  // same size and type: no allocation
     src.right.copyTo(dst.right);
+    if (!src.left_color.empty() && src.left_color.size() == dst.left_color.size()) {
+      src.left_color.copyTo(dst.left_color);  // colour slots (image sun providers)
+    }
   } else {
     SUNVO_RETURN_IF_ERROR(live_->next(dst));
   }

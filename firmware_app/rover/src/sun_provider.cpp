@@ -1,5 +1,8 @@
 #include "sunvo/rover/sun_provider.hpp"
 
+#include "sunvo/suncnn/sun_cnn_estimator.hpp"
+#include "sunvo/sunvision/lalonde_estimator.hpp"
+
 namespace sunvo::rover {
 
 Expected<std::optional<sunfusion::SunMeasurement>> CsvSunProvider::measure(const SunQuery& q) {
@@ -30,9 +33,20 @@ Expected<std::optional<sunfusion::SunMeasurement>> ImageSunProvider::measure(con
   return std::optional<sunfusion::SunMeasurement>(m);
 }
 
+namespace {
+Expected<std::unique_ptr<SunProvider>> lalonde(sunvision::LalondePrior prior,
+                                               const StereoCamera& camera) {
+  sunvision::LalondeOptions options;
+  options.prior = prior;
+  auto e = std::make_unique<sunvision::LalondeEstimator>(options);
+  const Status s = e->init();
+  if (!s.isOk()) return Status(s.code(), "sun.provider: " + s.message());
+  return std::unique_ptr<SunProvider>(new ImageSunProvider(std::move(e), camera));
+}
+}  // namespace
+
 Expected<std::unique_ptr<SunProvider>> makeSunProvider(const SunConfig& config,
                                                        const StereoCamera& camera) {
-  (void)camera;  // for the image estimators, e.g. ImageSunProvider(makeLalonde(...), camera)
   switch (config.provider) {
     case SunProviderType::kNone:
       return std::unique_ptr<SunProvider>();
@@ -40,6 +54,16 @@ Expected<std::unique_ptr<SunProvider>> makeSunProvider(const SunConfig& config,
       auto csv = files::readSunCsv(config.csv);
       if (!csv) return Status(csv.status().code(), "sun.csv: " + csv.status().message());
       return std::unique_ptr<SunProvider>(new CsvSunProvider(std::move(*csv), config.sigma));
+    }
+    case SunProviderType::kLalonde:
+      return lalonde(sunvision::LalondePrior::kZenith, camera);
+    case SunProviderType::kLalondeVo:
+      return lalonde(sunvision::LalondePrior::kVisualOdometry, camera);
+    case SunProviderType::kSunCnn: {
+      auto e = std::make_unique<suncnn::SunCnnEstimator>();
+      const Status s = e->init(suncnn::SunCnnOptions{}, config.model);
+      if (!s.isOk()) return Status(s.code(), "sun.model: " + s.message());
+      return std::unique_ptr<SunProvider>(new ImageSunProvider(std::move(e), camera));
     }
   }
   return invalidArgument("sun.provider: unknown");

@@ -30,19 +30,33 @@
 #include <vector>
 
 #include "sunvo/core/status.hpp"
+#include "sunvo/gpio/gpio_api.hpp"
 #include "sunvo/rover/config.hpp"
 #include "sunvo/rover/pose_link.hpp"
 #include "sunvo/rover/sources.hpp"
 #include "sunvo/rover/sun_provider.hpp"
+#include "sunvo/sysio/sysio.hpp"
 
 namespace sunvo::rover {
+
+// The kernel seams the V4L2 source and the GPIO trigger use (source.type v4l2, trigger.type
+// gpio). On the rover: sysio::linuxSysIo() and gpio::libgpiodApi(); tests pass the emulated
+// devices of hil/emulated_devices. Both must outlive the RoverApp.
+struct RoverDevices {
+  sysio::SysIo* io = nullptr;
+  gpio::GpioApi* gpio = nullptr;
+};
+// linuxSysIo() and libgpiodApi().
+RoverDevices productionDevices();
 
 class RoverApp {
  public:
   // Opens the source, the trigger and the sun provider, sizes every buffer, initialises the
-  // estimator. link may be null (no pose stream: publish = dequeue by telemetry).
+  // estimator. link may be null (no pose stream: publish = dequeue by telemetry). devices are
+  // used by source.type v4l2 / trigger.type gpio only.
   static Expected<std::unique_ptr<RoverApp>> create(const RoverConfig& config,
-                                                    std::unique_ptr<PoseLink> link);
+                                                    std::unique_ptr<PoseLink> link,
+                                                    const RoverDevices& devices);
   ~RoverApp();
   RoverApp(const RoverApp&) = delete;
   RoverApp& operator=(const RoverApp&) = delete;

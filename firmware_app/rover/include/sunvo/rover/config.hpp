@@ -15,6 +15,7 @@
 #include "sunvo/core/status.hpp"
 #include "sunvo/runtime/frame_pool.hpp"
 #include "sunvo/runtime/rt_setup.hpp"
+#include "sunvo/v4l2/stereo_source.hpp"
 
 namespace sunvo::rover {
 
@@ -31,7 +32,9 @@ enum class WorldInit {
   kOxts,    // origin and first camera pose from the replay drive's first OXTS record
   kConfig,  // origin from world.latitude/longitude/altitude, camera attitude from world.*_deg
 };
-enum class SunProviderType { kNone, kCsv };
+// none: pure VO; csv: a per-frame file; lalonde / lalonde_vo: sunvision::LalondeEstimator with the
+// zenith / the VO attitude as prior; sun_cnn: suncnn::SunCnnEstimator (ONNX model at sun.model).
+enum class SunProviderType { kNone, kCsv, kLalonde, kLalondeVo, kSunCnn };
 
 struct KittiSourceConfig {
   std::string drive_dir;          // KITTI raw drive folder (<date>/<date>_drive_NNNN_sync)
@@ -48,6 +51,10 @@ struct V4l2SourceConfig {
   std::string left_device = "/dev/video0";   // V4L2 node of the left camera
   std::string right_device = "/dev/video1";  // V4L2 node of the right camera
   std::string calibration = "";              // KITTI-style calib_cam_to_cam.txt of the rig
+  v4l2::V4l2Layout layout = v4l2::V4l2Layout::kTwoDevices;            // two_devices | side_by_side
+  v4l2::V4l2PixelFormat pixel_format = v4l2::V4l2PixelFormat::kGrey;  // grey | yuyv
+  int buffer_count = 4;          // MMAP buffers per device, [2, 32]
+  int dequeue_timeout_ms = 200;  // ms, [1, 60000]: the longest wait for one stereo pair
 };
 
 struct SourceConfig {
@@ -63,7 +70,9 @@ struct TriggerConfig {
   bool follow_recording = true;  // simulated: trigger at the recording's time deltas (first pass)
   double timeout_factor = 3.0;   // periods, [1.5, 100]: no trigger for this long -> counted missed
   std::string gpio_chip = "gpiochip0";  // gpio: chip name
-  int gpio_line = 0;                    // gpio: line offset, [0, 1023]
+  int gpio_line = 0;                    // gpio: line offset, [0, 1023] (the strobe input)
+  double frame_delay_ms = 0.0;    // gpio: ms, [-1000, 1000]: frame buffer timestamp - strobe edge
+  double match_window_ms = 10.0;  // gpio: ms, [0, half a period]: largest pairing error
 };
 
 struct QueueConfig {
@@ -98,11 +107,12 @@ struct EstimatorConfig {
 
 struct SunConfig {
   SunProviderType provider = SunProviderType::kNone;
-  int every_n_frames = 5;              // a measurement every n-th frame, [1, 1000]
-  std::string csv;                     // csv provider: "frame,sx,sy,sz" per recording frame
-  double sigma = 0.05;                 // csv provider: measurement sigma (R_s = sigma^2 I), (0, 2]
-  double wait_ms = 5.0;                // ms, [0, 100]: the estimator waits at most this long for a
-                                       //   sun frame's measurement (0 = never waits)
+  int every_n_frames = 5;  // a measurement every n-th frame, [1, 1000]
+  std::string csv;         // csv provider: "frame,sx,sy,sz" per recording frame
+  std::string model;       // sun_cnn provider: the ONNX model file (e.g. /etc/sunvo/sun_cnn.onnx)
+  double sigma = 0.05;     // csv provider: measurement sigma (R_s = sigma^2 I), (0, 2]
+  double wait_ms = 5.0;    // ms, [0, 100]: the estimator waits at most this long for a
+                           //   sun frame's measurement (0 = never waits)
   bool estimate_base_attitude = true;  // see sunfusion::SunFusionOptions
   double max_cosine_distance = 0.3;    // gate, [0, 2]
 };

@@ -104,7 +104,9 @@ class SimulatedTrigger final : public TriggerSource {
 // grab() decodes the next files (stop/hold only; libpng allocates per frame).
 class KittiReplaySource final : public FrameSource {
  public:
-  static Expected<std::unique_ptr<KittiReplaySource>> open(const KittiSourceConfig& config);
+  // color: also deliver the left/right colour images (image_02/03) into slots that have them.
+  static Expected<std::unique_ptr<KittiReplaySource>> open(const KittiSourceConfig& config,
+                                                           bool color = false);
   const StereoCamera& camera() const override { return camera_; }
   Status grab(const TriggerEvent& trigger, runtime::FrameSlot& slot) override;
 

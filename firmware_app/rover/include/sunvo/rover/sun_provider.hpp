@@ -66,6 +66,12 @@ class ImageSunProvider final : public SunProvider {
   StereoCamera camera_;
 };
 
+// True for the providers that look at the images (the source must deliver the left colour image).
+inline bool sunProviderNeedsImages(SunProviderType type) {
+  return type == SunProviderType::kLalonde || type == SunProviderType::kLalondeVo ||
+         type == SunProviderType::kSunCnn;
+}
+
 // nullptr for provider none.
 Expected<std::unique_ptr<SunProvider>> makeSunProvider(const SunConfig& config,
                                                        const StereoCamera& camera);

@@ -1,0 +1,193 @@
+// RoverApp on emulated hardware: source.type v4l2 (two EmulatedV4l2 cameras behind the SysIo
+// seam) and trigger.type gpio (the strobe line of an EmulatedGpio chip behind the GpioApi seam),
+// configured from config/rover.yaml. A test thread plays the rig: each exposure fires both
+// cameras (buffer timestamp = edge + 3 ms) and pulses the strobe line (kernel timestamp = edge).
+// Every frame must come out as one pose whose trigger time is its strobe edge; a strobe lost on
+// the line must be counted as a missed trigger and its frame skipped.
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <mutex>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+#include <regex>
+#include <thread>
+#include <vector>
+
+#include "sunvo/emulated/emulated_gpio.hpp"
+#include "sunvo/emulated/emulated_v4l2.hpp"
+#include "sunvo/rover/app.hpp"
+#include "sunvo/rover/config.hpp"
+#include "sunvo/runtime/clock.hpp"
+
+namespace sunvo::rover {
+namespace {
+
+constexpr int kWidth = 1242;  // the size of the calibration used (kitti_raw_sample)
+constexpr int kHeight = 375;
+constexpr TimeNs kExposureDelay = 3'000'000;  // strobe edge -> V4L2 buffer timestamp, ns
+constexpr double kRateHz = 20.0;
+constexpr int kStrobeLine = 17;
+
+// Records every pose the telemetry thread hands over (the port is not under test here).
+class RecordingLink final : public PoseLink {
+ public:
+  Status sendPose(const PoseRecord& pose, TimeNs now) override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    poses_.push_back(pose);
+    last_ns_ = now;
+    return Status::ok();
+  }
+  Status sendHeartbeat(TimeNs) override { return Status::ok(); }
+  Status service(TimeNs) override { return Status::ok(); }
+  bool drained() const override { return true; }
+  TimeNs lastByteWrittenNs() const override { return last_ns_; }
+  std::string countersText() const override { return "recording link"; }
+  std::vector<PoseRecord> poses() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return poses_;
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::vector<PoseRecord> poses_;
+  TimeNs last_ns_ = 0;
+};
+
+// A textured plane 12 px of disparity away, sliding 2 px per frame: trackable stereo images.
+emulated::FrameContent planeContent(const cv::Mat& texture, int disparity) {
+  return [texture, disparity](std::uint64_t frame, cv::Mat& gray) {
+    const int shift = static_cast<int>(frame % 100) * 2 + disparity;
+    texture(cv::Rect(shift, 0, gray.cols, gray.rows)).copyTo(gray);
+  };
+}
+
+struct RunResult {
+  std::vector<TimeNs> strobe_edges;  // the edges that reached the line (dropped one left out)
+  std::vector<PoseRecord> poses;
+  std::string summary;
+};
+
+RunResult runRig(int exposures, int drop_at) {
+  RunResult result;
+  emulated::EmulatedGpio gpio;
+  emulated::EmulatedV4l2 cameras;
+  EXPECT_TRUE(gpio.addChip("gpiochip0", 32).isOk());
+  cv::Mat texture(kHeight, kWidth + 260, CV_8UC1);
+  cv::RNG rng(7);
+  rng.fill(texture, cv::RNG::UNIFORM, 0, 256);
+  // Blobs rather than pixel noise (corners for the front end), stretched to the full range.
+  cv::GaussianBlur(texture, texture, cv::Size(0, 0), 2.0);
+  cv::normalize(texture, texture, 0, 255, cv::NORM_MINMAX);
+  EXPECT_TRUE(
+      cameras
+          .addCamera({"/dev/video0", kWidth, kHeight, true, true, 0, 0, planeContent(texture, 12)})
+          .isOk());
+  EXPECT_TRUE(
+      cameras
+          .addCamera({"/dev/video1", kWidth, kHeight, true, true, 0, 0, planeContent(texture, 0)})
+          .isOk());
+
+  const std::string out = std::string(SUNVO_BINARY_DIR) + "/test_out/rover_devices";
+  auto config = loadRoverConfig(
+      std::string(SUNVO_SOURCE_DIR) + "/config/rover.yaml",
+      {{"source.v4l2.calibration",
+        std::string(SUNVO_DATA_DIR) + "/kitti_raw_sample/2011_09_26/calib_cam_to_cam.txt"},
+       {"trigger.rate_hz", std::to_string(kRateHz)},
+       {"trigger.gpio_line", std::to_string(kStrobeLine)},
+       {"trigger.frame_delay_ms", "3.0"},
+       {"trigger.match_window_ms", "4.0"},
+       {"serial.device", "\"\""},
+       {"rt.lock_memory", "false"},
+       {"rt.heap_reserve_mb", "0"},
+       {"rt.threads",
+        "{capture: {fifo_priority: 0, cpu: -1}, estimator: {fifo_priority: 0, "
+        "cpu: -1}, sun: {fifo_priority: 0, cpu: -1}, telemetry: {fifo_priority: "
+        "0, cpu: -1}}"},
+       {"estimator.warmup_frames", "0"},
+       {"profiling.output_dir", out}});
+  EXPECT_TRUE(config.hasValue()) << config.status().toString();
+  if (!config) return result;
+  auto link = std::make_unique<RecordingLink>();
+  RecordingLink* recorder = link.get();
+  auto app = RoverApp::create(*config, std::move(link), RoverDevices{&cameras, &gpio});
+  EXPECT_TRUE(app.hasValue()) << app.status().toString();
+  if (!app) return result;
+  (*app)->start();
+
+  const auto period_ns = static_cast<TimeNs>(1e9 / kRateHz);
+  const TimeNs t0 = runtime::monotonicNs() + 50'000'000;
+  for (int k = 0; k < exposures; ++k) {
+    // The edge is stamped on the exact grid, as a camera's strobe is: the time this thread
+    // wakes up on a loaded machine must not look like a missed trigger.
+    const TimeNs edge = t0 + k * period_ns;
+    runtime::sleepUntilMonotonicNs(edge);
+    if (k == drop_at) {
+      EXPECT_TRUE(gpio.dropStrobes("gpiochip0", kStrobeLine, 1).isOk());
+    } else {
+      result.strobe_edges.push_back(edge);
+    }
+    cameras.trigger(edge + kExposureDelay);
+    EXPECT_TRUE(gpio.strobe("gpiochip0", kStrobeLine, edge, 1'000'000).isOk());
+  }
+  // Wait for the estimator to finish the frames (bounded), then stop.
+  const auto expected = static_cast<std::uint64_t>(result.strobe_edges.size());
+  const TimeNs give_up = runtime::monotonicNs() + 20'000'000'000;
+  while ((*app)->framesProcessed() < expected && runtime::monotonicNs() < give_up) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  (*app)->requestStop();
+  (*app)->join();
+  result.poses = recorder->poses();
+  result.summary = (*app)->summary();
+  std::printf("%s", result.summary.c_str());
+  return result;
+}
+
+std::uint64_t summaryCount(const std::string& summary, const std::string& pattern) {
+  std::smatch m;
+  const std::regex re(pattern);
+  if (!std::regex_search(summary, m, re)) {
+    ADD_FAILURE() << "no '" << pattern << "' in " << summary;
+    return 0;
+  }
+  return std::strtoull(m[1].str().c_str(), nullptr, 10);
+}
+
+void expectPosesAtStrobes(const RunResult& r) {
+  ASSERT_EQ(r.poses.size(), r.strobe_edges.size());
+  const TimeNs utc_minus_mono = runtime::utcNowNs() - runtime::monotonicNs();
+  for (std::size_t i = 0; i < r.poses.size(); ++i) {
+    const PoseRecord& p = r.poses[i];
+    EXPECT_EQ(p.sequence, i);  // the strobe count: consecutive, a lost strobe takes no number
+    EXPECT_EQ(p.trigger_mono_ns, r.strobe_edges[i]) << i;
+    // The UTC time is the strobe edge mapped with one offset (UTC - monotonic, taken at start).
+    EXPECT_EQ(p.utc_ns - p.trigger_mono_ns, r.poses[0].utc_ns - r.poses[0].trigger_mono_ns);
+    EXPECT_LT(std::llabs((p.utc_ns - p.trigger_mono_ns) - utc_minus_mono), 50'000'000) << i;
+    EXPECT_TRUE(std::isfinite(p.p_w[0]) && std::isfinite(p.p_w[1]) && std::isfinite(p.p_w[2]));
+  }
+}
+
+TEST(RoverDevices, EveryStrobedFrameBecomesAPoseAtItsStrobeTime) {
+  const RunResult r = runRig(20, -1);
+  expectPosesAtStrobes(r);
+  EXPECT_EQ(summaryCount(r.summary, "triggers ([0-9]+) "), 20u);
+  EXPECT_EQ(summaryCount(r.summary, "missed ([0-9]+)"), 0u);
+  EXPECT_EQ(summaryCount(r.summary, "frames grabbed ([0-9]+)"), 20u);
+}
+
+TEST(RoverDevices, ALostStrobeIsAMissedTriggerAndItsFrameIsSkipped) {
+  const RunResult r = runRig(20, 9);
+  expectPosesAtStrobes(r);
+  EXPECT_EQ(r.poses.size(), 19u);
+  EXPECT_EQ(summaryCount(r.summary, "triggers ([0-9]+) "), 19u);
+  EXPECT_EQ(summaryCount(r.summary, "missed ([0-9]+)"), 1u);
+  EXPECT_EQ(summaryCount(r.summary, "grab errors ([0-9]+)"), 0u);
+}
+
+}  // namespace
+}  // namespace sunvo::rover
