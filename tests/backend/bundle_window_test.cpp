@@ -264,6 +264,7 @@ TEST(BundleWindow, MotionPriorPullsTowardThePrediction) {
   predicted.translation() += Eigen::Vector3d(0.0, 0.0, 0.2);
   WindowOptions wo;
   wo.max_num_iterations = 50;
+  wo.max_solver_time_in_seconds = 10.0;  // bounded by iterations (slow under qemu-aarch64)
   {
     BundleWindow w;  // prior disabled: the data wins
     twoFrames(w, wo, T_1_0, &predicted);
@@ -330,7 +331,7 @@ TEST(BundleWindow, SolverTimeBudgetBoundsTheSolve) {
   const auto pts = testing::makeLandmarks(so, 2.0);
   WindowOptions wo;
   wo.max_num_iterations = 50;
-  wo.max_solver_time_in_seconds = 1.0;
+  wo.max_solver_time_in_seconds = 30.0;  // generous: under qemu-aarch64 a full solve takes ~1 s
   Isometry3 guess = T_k_km1;
   guess.linear() = expSO3(Eigen::Vector3d(0.0, 2.0 * M_PI / 180.0, 0.0)) * guess.linear();
   guess.translation() += Eigen::Vector3d(0.2, -0.1, 0.3);
@@ -350,16 +351,16 @@ TEST(BundleWindow, SolverTimeBudgetBoundsTheSolve) {
     return s ? *s : WindowSolveSummary{};
   };
   double applied = 0.0;
-  const WindowSolveSummary full = solveWith(0.5, &applied);
-  EXPECT_EQ(applied, 0.5);
+  const WindowSolveSummary full = solveWith(20.0, &applied);
+  EXPECT_EQ(applied, 20.0);
   EXPECT_TRUE(full.converged);
   EXPECT_GT(full.iterations, 1);
   const WindowSolveSummary starved = solveWith(1e-9, &applied);
   EXPECT_EQ(applied, 1e-9);
   EXPECT_FALSE(starved.converged);
   EXPECT_LT(starved.iterations, full.iterations);
-  solveWith(5.0, &applied);  // above the configured limit: clamped
-  EXPECT_EQ(applied, 1.0);
+  solveWith(50.0, &applied);  // above the configured limit: clamped
+  EXPECT_EQ(applied, 30.0);
   solveWith(std::nan(""), &applied);  // not a budget: the configured limit
   EXPECT_EQ(applied, 1.0);
   solveWith(-1.0, &applied);

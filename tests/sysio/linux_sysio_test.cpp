@@ -29,7 +29,10 @@ TEST(LinuxSysIo, OpenAndCloseReportErrnoValues) {
   // A V4L2 request on a device that is no video device.
   v4l2_capability cap{};
   const SysResult q = ioctlRetry(io, fd, VIDIOC_QUERYCAP, &cap);
-  EXPECT_EQ(q.err, ENOTTY);
+  // The kernel says ENOTTY; qemu-user (the aarch64 tests) answers ioctls it does not translate
+  // with ENOSYS. Either way the errno value itself must come back.
+  EXPECT_EQ(q.value, -1);
+  EXPECT_TRUE(q.err == ENOTTY || q.err == ENOSYS) << "errno " << q.err;
   EXPECT_TRUE(io.close(fd).ok());
   EXPECT_EQ(io.close(fd).err, EBADF);
 }
