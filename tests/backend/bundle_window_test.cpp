@@ -362,9 +362,9 @@ TEST(BundleWindow, SolverTimeBudgetBoundsTheSolve) {
   solveWith(50.0, &applied);  // above the configured limit: clamped
   EXPECT_EQ(applied, 30.0);
   solveWith(std::nan(""), &applied);  // not a budget: the configured limit
-  EXPECT_EQ(applied, 1.0);
+  EXPECT_EQ(applied, 30.0);
   solveWith(-1.0, &applied);
-  EXPECT_EQ(applied, 1.0);
+  EXPECT_EQ(applied, 30.0);
 }
 
 }  // namespace
