@@ -3,7 +3,10 @@
 // stops the program with SIGTERM, and evaluates accuracy and latency. Compared with the
 // sequential replay (sunvo_replay's chain) on the same frames.
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/file.h>
+#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -44,6 +47,15 @@ std::string findOrRenderDrive(int* frames) {
   *frames = 20;
   const fs::path out = fs::path(SUNVO_BINARY_DIR) / "test_render_cache" / "rover_20";
   const fs::path done = out / "complete";
+  // The tests of this file run in parallel under ctest -j: one renders, the others wait for it
+  // (an exclusive lock held until this function returns).
+  fs::create_directories(out.parent_path());
+  const int lock_fd = ::open((out.string() + ".lock").c_str(), O_CREAT | O_RDWR | O_CLOEXEC, 0644);
+  if (lock_fd < 0 || ::flock(lock_fd, LOCK_EX) != 0) return {};
+  struct Unlock {
+    int fd;
+    ~Unlock() { ::close(fd); }  // closing releases the lock
+  } unlock{lock_fd};
   if (fs::exists(done)) {
     std::ifstream in(done);
     std::string drive;
