@@ -120,8 +120,7 @@ Expected<ReplayRun> replayDrive(const ReplayOptions& options,
     }
     sunfusion::SunFusionOptions fusion = options.fusion;
     fusion.world_up = Eigen::Vector3d::UnitZ();  // ENU
-    // Azimuth-only estimators are gated in the x-z plane, as the error-model Sun-CNN source.
-    if (std::string(image_sun->name()) == "sun_cnn") fusion.gate.plane = sunfusion::GatePlane::kXZ;
+    // An azimuth-only measurement (Sun-CNN) is gated in the x-z plane by gateSunMeasurement itself.
     SUNVO_RETURN_IF_ERROR(sun_term.init(fusion));
     sun_term.attach(vo.odometry().window());
   }
