@@ -33,8 +33,8 @@ TEST(RoverConfig, TheShippedConfigsLoad) {
   EXPECT_EQ(replay->source.kitti.end, EndAction::kHold);
   EXPECT_EQ(replay->frames.width, 1242);
   EXPECT_EQ(replay->rt.capture.fifo_priority, 80);
-  // The deployment file: V4L2 pair with the GPIO strobe; an image sun provider is refused there
-  // (the V4L2 source delivers gray), naming the key.
+  // The deployment file: V4L2 pair with the GPIO strobe; Sun-CNN is refused there (the V4L2
+  // source delivers gray and the CNN needs colour), naming the key; Lalonde takes gray.
   auto rover = loadRoverConfig(std::string(SUNVO_SOURCE_DIR) + "/config/rover.yaml");
   ASSERT_TRUE(rover) << rover.status().toString();
   EXPECT_EQ(rover->source.type, SourceType::kV4l2);
@@ -45,6 +45,9 @@ TEST(RoverConfig, TheShippedConfigsLoad) {
   ASSERT_FALSE(gray);
   EXPECT_NE(gray.status().message().find("sun.provider: sun_cnn"), std::string::npos)
       << gray.status().message();
+  auto lalonde = loadRoverConfig(std::string(SUNVO_SOURCE_DIR) + "/config/rover.yaml",
+                                 {{"sun.provider", "lalonde_vo"}});
+  EXPECT_TRUE(lalonde) << lalonde.status().toString();
   auto no_gpio = loadRoverConfig(std::string(SUNVO_SOURCE_DIR) + "/config/rover.yaml",
                                  {{"trigger.type", "simulated"}});
   ASSERT_FALSE(no_gpio);

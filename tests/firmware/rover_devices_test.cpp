@@ -72,7 +72,7 @@ struct RunResult {
   std::string summary;
 };
 
-RunResult runRig(int exposures, int drop_at) {
+RunResult runRig(int exposures, int drop_at, const std::string& sun_provider = "none") {
   RunResult result;
   emulated::EmulatedGpio gpio;
   emulated::EmulatedV4l2 cameras;
@@ -109,6 +109,7 @@ RunResult runRig(int exposures, int drop_at) {
         "cpu: -1}, sun: {fifo_priority: 0, cpu: -1}, telemetry: {fifo_priority: "
         "0, cpu: -1}}"},
        {"estimator.warmup_frames", "0"},
+       {"sun.provider", sun_provider},
        {"profiling.output_dir", out}});
   EXPECT_TRUE(config.hasValue()) << config.status().toString();
   if (!config) return result;
@@ -187,6 +188,19 @@ TEST(RoverDevices, ALostStrobeIsAMissedTriggerAndItsFrameIsSkipped) {
   EXPECT_EQ(summaryCount(r.summary, "triggers ([0-9]+) "), 19u);
   EXPECT_EQ(summaryCount(r.summary, "missed ([0-9]+)"), 1u);
   EXPECT_EQ(summaryCount(r.summary, "grab errors ([0-9]+)"), 0u);
+}
+
+TEST(RoverDevices, LalondeRunsOnTheGrayFramesOfTheV4l2Cameras) {
+  // The V4L2 driver delivers luma only; Lalonde-VO accepts gray, so every fifth frame of 0-19
+  // (5, 10, 15) goes to the sun thread and comes back without an error (the textured plane shows no sky
+  // or shadows, so whether it yields a measurement is not asserted).
+  const RunResult r = runRig(20, -1, "lalonde_vo");
+  expectPosesAtStrobes(r);
+  EXPECT_NE(r.summary.find("sun (lalonde_vo)"), std::string::npos) << r.summary;
+  EXPECT_EQ(summaryCount(r.summary, "sun \\(lalonde_vo\\): requests ([0-9]+)"), 3u);
+  EXPECT_EQ(summaryCount(r.summary, "sun \\(lalonde_vo\\): requests [0-9]+, measurements [0-9]+, "
+                                    "errors ([0-9]+)"),
+            0u);
 }
 
 }  // namespace

@@ -360,7 +360,7 @@ Status RoverConfig::validate() const {
   if (sun.provider == SunProviderType::kCsv && sun.csv.empty()) {
     return invalidArgument("sun.csv: empty, but sun.provider is csv");
   }
-  if (sunProviderNeedsImages(sun.provider) && source.type == SourceType::kV4l2) {
+  if (sunProviderNeedsColour(sun.provider) && source.type == SourceType::kV4l2) {
     return invalidArgument("sun.provider: " + kSunNames[static_cast<std::size_t>(sun.provider)] +
                            " needs the left colour image; source.type: v4l2 delivers gray");
   }

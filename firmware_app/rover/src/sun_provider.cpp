@@ -19,11 +19,16 @@ Expected<std::optional<sunfusion::SunMeasurement>> CsvSunProvider::measure(const
 }
 
 Expected<std::optional<sunfusion::SunMeasurement>> ImageSunProvider::measure(const SunQuery& q) {
-  if (q.images == nullptr || q.images->left_color.empty()) {
-    return failedPrecondition(std::string(name()) + ": no colour image for frame " +
-                              std::to_string(q.sequence));
+  // The colour image when the source delivers one; else the gray left image, for an estimator
+  // that accepts it (a monochrome V4L2 camera).
+  const bool colour = q.images != nullptr && !q.images->left_color.empty();
+  const bool gray = q.images != nullptr && !q.images->left.empty() && estimator_->acceptsGray();
+  if (!colour && !gray) {
+    return failedPrecondition(std::string(name()) + ": no " +
+                              (estimator_->acceptsGray() ? "image" : "colour image") +
+                              " for frame " + std::to_string(q.sequence));
   }
-  sunfusion::ImageSunInput in{q.images->left_color, camera_, q.prior};
+  sunfusion::ImageSunInput in{colour ? q.images->left_color : q.images->left, camera_, q.prior};
   auto e = estimator_->estimate(in);
   if (!e) return e.status();
   if (!e->valid) return std::optional<sunfusion::SunMeasurement>();

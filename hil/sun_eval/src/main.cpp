@@ -292,15 +292,15 @@ int run(const Args& args) {
       const double true_az = std::atan2(f.true_sun_c.x(), f.true_sun_c.z()) / kDeg;
       const double true_zen =
           std::acos(std::clamp(f.true_sun_c.dot(f.true_up_c), -1.0, 1.0)) / kDeg;
-      // Sun-CNN takes colour only; a gray frame (the KITTI odometry sample) goes in as three equal
-      // channels. Lalonde handles gray itself (its colour tests are skipped).
+      // An estimator that takes colour only (Sun-CNN) gets a gray frame (the KITTI odometry
+      // sample) as three equal channels; one that acceptsGray() (Lalonde) gets it as it is.
       sunvo::sunfusion::ImageSunInput in_bgr = in;
       if (image.type() == CV_8UC1) cv::cvtColor(image, in_bgr.color, cv::COLOR_GRAY2BGR);
       for (std::size_t ei = 0; ei < estimators->size(); ++ei) {
         sunvo::sunfusion::ImageSunEstimator& est = *(*estimators)[ei];
-        const bool colour_only = std::string(est.name()) == "sun_cnn";
         const double cpu0 = threadCpuMs();
-        Expected<sunvo::sunfusion::ImageSunEstimate> e = est.estimate(colour_only ? in_bgr : in);
+        Expected<sunvo::sunfusion::ImageSunEstimate> e =
+            est.estimate(est.acceptsGray() ? in : in_bgr);
         const double cpu_ms = threadCpuMs() - cpu0;
         if (!e) {
           std::fprintf(stderr, "sunvo_sun_eval: %s on %s: %s\n", est.name(), f.image_path.c_str(),

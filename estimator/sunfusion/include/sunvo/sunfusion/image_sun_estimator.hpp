@@ -30,7 +30,7 @@ struct SunPrior {
 };
 
 struct ImageSunInput {
-  cv::Mat color;                  // rectified camera-0 image, CV_8UC3 (BGR)
+  cv::Mat color;  // rectified camera-0 image, CV_8UC3 (BGR); CV_8UC1 where acceptsGray()
   StereoCamera camera;            // intrinsics of that image (only fu, fv, cu, cv, width, height)
   std::optional<SunPrior> prior;  // the camera's "up" and, when known, the predicted sun
 };
@@ -48,6 +48,9 @@ class ImageSunEstimator {
  public:
   virtual ~ImageSunEstimator() = default;
   virtual const char* name() const = 0;  // "lalonde", "lalonde_vo", "sun_cnn"
+  // True if a gray (CV_8UC1) image is a valid input, e.g. from a monochrome V4L2 camera; the
+  // estimator then skips its colour cues. False: colour only (give a gray frame as GRAY2BGR).
+  virtual bool acceptsGray() const { return false; }
   // The image is not kept. Errors: wrong image type or size, estimator not initialised.
   virtual Expected<ImageSunEstimate> estimate(const ImageSunInput& input) = 0;
 };

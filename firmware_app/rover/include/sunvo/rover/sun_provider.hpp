@@ -66,10 +66,16 @@ class ImageSunProvider final : public SunProvider {
   StereoCamera camera_;
 };
 
-// True for the providers that look at the images (the source must deliver the left colour image).
+// True for the providers that look at the images.
 inline bool sunProviderNeedsImages(SunProviderType type) {
   return type == SunProviderType::kLalonde || type == SunProviderType::kLalondeVo ||
          type == SunProviderType::kSunCnn;
+}
+
+// True for the providers that need the left colour image; Lalonde (acceptsGray) also runs on the
+// gray left image of a monochrome camera.
+inline bool sunProviderNeedsColour(SunProviderType type) {
+  return type == SunProviderType::kSunCnn;
 }
 
 // nullptr for provider none.
