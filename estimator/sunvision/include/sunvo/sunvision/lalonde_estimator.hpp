@@ -20,7 +20,8 @@
 //    lines along the camera's forward axis (curbs, markings) are down-weighted;
 //  - prior: Lalonde's zenith prior, a Gaussian over theta (from sun statistics of daytime
 //    photographs), or for Lalonde-VO a Gaussian around the sun predicted from the VO pose,
-//    sigma_az = 120 deg, sigma_zen = 30 deg (3 sigma spans 360 deg and 90 deg).
+//    sigma_az = 60 deg, sigma_zen = 15 deg: the paper chooses them so that the 3-sigma bounds
+//    (mean +- 3 sigma) span 360 deg in azimuth and 90 deg in zenith.
 // The estimate's sigma (R_s = sigma^2 I) is the posterior's RMS angle to the best cell / sqrt(2)
 // (two tangent components), clamped; valid = false when neither image cue is informative.
 //
@@ -81,8 +82,8 @@ struct LalondeOptions {
   // Priors.
   double zenith_prior_mean_deg = 50.0;   // Lalonde prior, deg, [0, 90]
   double zenith_prior_sigma_deg = 20.0;  // deg, (0, 180]
-  double vo_sigma_azimuth_deg = 120.0;   // Lalonde-VO, deg, (0, 360]
-  double vo_sigma_zenith_deg = 30.0;     // deg, (0, 180]
+  double vo_sigma_azimuth_deg = 60.0;    // Lalonde-VO, deg, (0, 360]
+  double vo_sigma_zenith_deg = 15.0;     // deg, (0, 180]
   // Output.
   double min_sigma = 0.03;              // floor of SunMeasurement.sigma, (0, 2]
   double max_sigma = 1.0;               // ceiling, [min_sigma, 2]
