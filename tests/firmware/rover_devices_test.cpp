@@ -192,14 +192,15 @@ TEST(RoverDevices, ALostStrobeIsAMissedTriggerAndItsFrameIsSkipped) {
 
 TEST(RoverDevices, LalondeRunsOnTheGrayFramesOfTheV4l2Cameras) {
   // The V4L2 driver delivers luma only; Lalonde-VO accepts gray, so every fifth frame of 0-19
-  // (5, 10, 15) goes to the sun thread and comes back without an error (the textured plane shows no sky
-  // or shadows, so whether it yields a measurement is not asserted).
+  // (5, 10, 15) goes to the sun thread and comes back without an error (the textured plane shows no
+  // sky or shadows, so whether it yields a measurement is not asserted).
   const RunResult r = runRig(20, -1, "lalonde_vo");
   expectPosesAtStrobes(r);
   EXPECT_NE(r.summary.find("sun (lalonde_vo)"), std::string::npos) << r.summary;
   EXPECT_EQ(summaryCount(r.summary, "sun \\(lalonde_vo\\): requests ([0-9]+)"), 3u);
-  EXPECT_EQ(summaryCount(r.summary, "sun \\(lalonde_vo\\): requests [0-9]+, measurements [0-9]+, "
-                                    "errors ([0-9]+)"),
+  EXPECT_EQ(summaryCount(r.summary,
+                         "sun \\(lalonde_vo\\): requests [0-9]+, measurements [0-9]+, "
+                         "errors ([0-9]+)"),
             0u);
 }
 

@@ -30,8 +30,8 @@ struct SunPrior {
 };
 
 struct ImageSunInput {
-  cv::Mat color;  // rectified camera-0 image, CV_8UC3 (BGR); CV_8UC1 where acceptsGray()
-  StereoCamera camera;            // intrinsics of that image (only fu, fv, cu, cv, width, height)
+  cv::Mat color;        // rectified camera-0 image, CV_8UC3 (BGR); CV_8UC1 where acceptsGray()
+  StereoCamera camera;  // intrinsics of that image (only fu, fv, cu, cv, width, height)
   std::optional<SunPrior> prior;  // the camera's "up" and, when known, the predicted sun
 };
 
