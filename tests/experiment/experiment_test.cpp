@@ -25,7 +25,7 @@ TEST(Experiment, TrueSunCutsRotationDriftOnRealTracks) {
   ExperimentOptions opt;
   opt.max_frames = 400;
   opt.fusion.attitude_drift_deg_per_frame = 0.2;
-  opt.fusion.adaptive_drift = false;
+  opt.fusion.drift_adaptation = sunfusion::DriftAdaptation::kFixed;
   // Replay mode: bounded by iterations only. A wall-clock limit makes results depend on load.
   opt.vo.window.max_solver_time_in_seconds = 60.0;
   auto pure = runRoute(*route, std::nullopt, opt);

@@ -1,6 +1,7 @@
 #include "sunvo/sunfusion/sun_window_term.hpp"
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -11,6 +12,25 @@
 namespace sunvo::sunfusion {
 namespace {
 constexpr double kDeg = M_PI / 180.0;
+
+// Chi-square CDF for 1, 2 or 3 degrees of freedom (closed forms).
+double chiSquareCdf(double x, int dof) {
+  if (x <= 0.0) return 0.0;
+  const double e = std::erf(std::sqrt(0.5 * x));
+  if (dof == 1) return e;
+  if (dof == 2) return 1.0 - std::exp(-0.5 * x);
+  return e - std::sqrt(2.0 * x / M_PI) * std::exp(-0.5 * x);
+}
+
+// x with chiSquareCdf(x, dof) = p, by bisection (p in (0, 1)).
+double chiSquareQuantile(double p, int dof) {
+  double lo = 0.0, hi = 200.0;
+  for (int i = 0; i < 100; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (chiSquareCdf(mid, dof) < p ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
 }  // namespace
 
 Status SunFusionOptions::validate() const {
@@ -35,6 +55,21 @@ Status SunFusionOptions::validate() const {
   if (!(drift_adaptation_rate > 0.0 && drift_adaptation_rate <= 1.0)) {
     return invalidArgument("sun_fusion.drift_adaptation_rate out of range (0, 1]");
   }
+  if (!(persistence_forgetting > 0.0 && persistence_forgetting < 1.0)) {
+    return invalidArgument("sun_fusion.persistence_forgetting out of range (0, 1)");
+  }
+  if (!(persistence_false_alarm > 0.0 && persistence_false_alarm <= 0.5)) {
+    return invalidArgument("sun_fusion.persistence_false_alarm out of range (0, 0.5]");
+  }
+  if (!(persistence_step_up > 0.0 && persistence_step_up <= 2.0)) {
+    return invalidArgument("sun_fusion.persistence_step_up out of range (0, 2]");
+  }
+  if (!(persistence_step_down > 0.0 && persistence_step_down <= 2.0)) {
+    return invalidArgument("sun_fusion.persistence_step_down out of range (0, 2]");
+  }
+  if (!(persistence_huber > 0.0 && persistence_huber <= 100.0)) {
+    return invalidArgument("sun_fusion.persistence_huber out of range (0, 100]");
+  }
   if (!(innovation_gate_chi2 >= 0.0 && innovation_gate_chi2 <= 1e6)) {
     return invalidArgument("sun_fusion.innovation_gate_chi2 out of range [0, 1e6]");
   }
@@ -53,6 +88,14 @@ Status SunWindowTerm::init(const SunFusionOptions& options) {
   const double s0 = options.initial_attitude_sigma_deg * kDeg;
   P_ = Eigen::Matrix3d::Identity() * s0 * s0;
   drift_deg_per_frame_ = options.attitude_drift_deg_per_frame;
+  persistence_g_.setZero();
+  persistence_I_.setZero();
+  persistence_T_ = 0.0;
+  persistence_bound_[0] = 0.0;
+  for (int dof = 1; dof <= 3; ++dof) {
+    persistence_bound_[static_cast<std::size_t>(dof)] =
+        chiSquareQuantile(1.0 - options.persistence_false_alarm, dof);
+  }
   last_sequence_.reset();
   num_used_ = 0;
   return Status::ok();
@@ -93,12 +136,13 @@ Status SunWindowTerm::onSolve(backend::BundleWindow& window) {
       const double up = p.obs.sun_w.dot(options_.world_up);
       GateResult r = gateSunMeasurement(options_.gate, predicted_c, up, p.obs.measurement);
       if (r == GateResult::kAccepted && estimate) {
-        int m = 0;
-        const double nis = innovationSq(window.T_k_b(s), sun_b, p.obs.measurement, P_b, &m);
-        if (options_.innovation_gate_chi2 > 0.0 && nis > options_.innovation_gate_chi2) {
+        Innovation inn;
+        const bool finite = innovation(window.T_k_b(s), sun_b, p.obs.measurement, P_b, &inn);
+        if (!finite ||
+            (options_.innovation_gate_chi2 > 0.0 && inn.nis > options_.innovation_gate_chi2)) {
           r = GateResult::kRejectedInnovation;
-        } else if (options_.adaptive_drift && m > 0) {
-          adaptDrift(nis, m);
+        } else {
+          adaptDrift(inn, window.T_w_b().linear());
         }
       }
       counters_.count(r);
@@ -189,38 +233,76 @@ bool SunWindowTerm::evaluateAt(const ceres::CostFunction& cost, const Isometry3&
          J_d->topRows(*m).allFinite();
 }
 
-void SunWindowTerm::adaptDrift(double nis, int dof) {
-  // Robust innovation-based adaptation (a stochastic approximation of the median): with a
-  // consistent filter the NIS is chi-square with `dof` degrees of freedom and exceeds its median
-  // half of the time. q_theta is raised by a log-step when the NIS is above that median and
-  // lowered when below, so it settles where the innovations are consistent; an outlier moves it
-  // by one step only, whatever its size.
-  const double median = dof <= 1 ? 0.455 : (dof == 2 ? 1.386 : 2.366);
-  const double step =
-      nis > median ? options_.drift_adaptation_rate : -options_.drift_adaptation_rate;
+void SunWindowTerm::adaptDrift(const Innovation& inn, const Eigen::Matrix3d& C_w_b) {
+  const int m = inn.dof;
+  double step = 0.0;
+  switch (options_.drift_adaptation) {
+    case DriftAdaptation::kFixed:
+      return;
+    case DriftAdaptation::kInnovationMedian: {
+      // With a consistent filter the NIS is chi-square with m dof and exceeds its median half of
+      // the time: a stochastic approximation of the median, one step per measurement.
+      const double median = m <= 1 ? 0.455 : (m == 2 ? 1.386 : 2.366);
+      step = inn.nis > median ? options_.drift_adaptation_rate : -options_.drift_adaptation_rate;
+      break;
+    }
+    case DriftAdaptation::kPersistence: {
+      // r ~ r0 + J delta_b and delta_b = C_b_w dtheta_w, so H = J C_b_w is the Jacobian wrt the
+      // world-frame attitude error. If dtheta_w stayed constant while the filter ignores it, the
+      // whitened innovations r_i ~ N(H_i dtheta_w, I) and the least-squares estimate from all of
+      // them, I^+ g with g = sum H_i^T r_i and I = sum H_i^T H_i, has the chi-square statistic
+      // T = g^T I^+ g with rank(I) dof when dtheta_w = 0 (noise only). The sums forget by
+      // persistence_forgetting per measurement, so T weighs the recent drift; a Huber weight
+      // caps an outlier's pull at persistence_huber sigmas per row.
+      const Eigen::MatrixXd H = inn.J.topRows(m) * C_w_b.transpose();
+      const Eigen::VectorXd r = inn.r.head(m);
+      const double cap = options_.persistence_huber * std::sqrt(static_cast<double>(m));
+      const double norm = r.norm();
+      const double w = norm > cap ? cap / norm : 1.0;
+      const double lambda = options_.persistence_forgetting;
+      persistence_g_ = lambda * persistence_g_ + H.transpose() * (w * r);
+      persistence_I_ = lambda * persistence_I_ + H.transpose() * H;
+      // Pseudo-inverse: one sun direction never informs the rotation about itself, and directions
+      // with less than 1e-3 of the strongest information count as unobserved (rank drops).
+      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(persistence_I_);
+      const double floor = 1e-3 * std::max(eig.eigenvalues().maxCoeff(), 1e-300);
+      double T = 0.0;
+      std::size_t rank = 0;
+      for (int i = 0; i < 3; ++i) {
+        const double l = eig.eigenvalues()(i);
+        if (l > floor) {
+          const double proj = eig.eigenvectors().col(i).dot(persistence_g_);
+          T += proj * proj / l;
+          ++rank;
+        }
+      }
+      persistence_T_ = T;
+      step = rank > 0 && T > persistence_bound_[rank] ? options_.persistence_step_up
+                                                      : -options_.persistence_step_down;
+      break;
+    }
+  }
   drift_deg_per_frame_ *= std::exp(step);
   drift_deg_per_frame_ = std::clamp(drift_deg_per_frame_, options_.min_drift_deg_per_frame,
                                     options_.max_drift_deg_per_frame);
 }
 
-double SunWindowTerm::innovationSq(const Isometry3& T_k_b, const Eigen::Vector3d& sun_b,
-                                   const SunMeasurement& m, const Eigen::Matrix3d& P_b,
-                                   int* dof) const {
+bool SunWindowTerm::innovation(const Isometry3& T_k_b, const Eigen::Vector3d& sun_b,
+                               const SunMeasurement& m, const Eigen::Matrix3d& P_b,
+                               Innovation* out) const {
   const bool azimuth = m.kind == SunMeasurementKind::kAzimuthOnly;
   const std::unique_ptr<ceres::CostFunction> cost(
       azimuth ? SunAzimuthResidual::CreateWithBaseCorrection(sun_b, xzDirection(m.sun_c), m.sigma)
               : SunDirectionResidual::CreateWithBaseCorrection(sun_b, m.sun_c, m.sigma));
   const double zero[3] = {0.0, 0.0, 0.0};
-  Eigen::Vector3d r;
-  Eigen::Matrix<double, 3, 3, Eigen::RowMajor> J_d;
   int n = 0;
-  *dof = 0;
-  if (!evaluateAt(*cost, T_k_b, zero, &r, &J_d, &n)) return std::numeric_limits<double>::infinity();
-  *dof = n;
-  const Eigen::MatrixXd J = J_d.topRows(n);
+  if (!evaluateAt(*cost, T_k_b, zero, &out->r, &out->J, &n) || n <= 0) return false;
+  out->dof = n;
+  const Eigen::MatrixXd J = out->J.topRows(n);
   const Eigen::MatrixXd S = J * P_b * J.transpose() + Eigen::MatrixXd::Identity(n, n);
-  const Eigen::VectorXd rn = r.head(n);
-  return rn.dot(S.ldlt().solve(rn));
+  const Eigen::VectorXd rn = out->r.head(n);
+  out->nis = rn.dot(S.ldlt().solve(rn));
+  return std::isfinite(out->nis);
 }
 
 }  // namespace sunvo::sunfusion

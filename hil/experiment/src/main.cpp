@@ -5,14 +5,18 @@
 //
 // Usage: sunvo_experiment [--data DIR] [--out DIR] [--routes 0020,00,06] [--frames N]
 //                         [--every N] [--seed N] [--drift-deg D] [--sun-loss S] [--paper-form]
-//                         [--write-poses] [--fixed-drift]
-//                         [--innovation-gate X]
+//                         [--write-poses] [--fixed-drift] [--drift-rule R]
+//                         [--innovation-gate X] [--initial-sigma-deg S] [--max-drift-deg M]
 //   --drift-deg   attitude random walk of VO per frame for the sun fusion (deg; the start value
 //                 when it adapts)
 //   --sun-loss    Cauchy scale on the whitened sun residual (0 = none)
 //   --paper-form  hold the base attitude fixed, as the paper did
 //   --fixed-drift keep the attitude random walk at --drift-deg instead of adapting it
+//   --drift-rule  how the random walk adapts: persistence (default), median or fixed
 //   --innovation-gate  chi-square bound of the innovation gate (0 = off)
+//   --max-drift-deg  upper bound of the adapted random walk (deg/frame)
+//   --initial-sigma-deg  prior sigma of the first pose's attitude (deg; default 0.1, since VO
+//                 starts at the ground-truth pose)
 //   --write-poses also write every run's poses and the ground truth as KITTI pose files
 //                 (route_<id>_gt.txt, route_<id>_run<i>.txt; run 0 is pure VO, then the sources)
 
@@ -37,7 +41,8 @@ int usage(const std::string& msg) {
   std::fprintf(stderr,
                "usage: sunvo_experiment [--data DIR] [--out DIR] [--routes 0020,00,06] "
                "[--frames N] [--every N] [--seed N] [--drift-deg D] [--sun-loss S] [--paper-form] "
-               "[--write-poses] [--fixed-drift] [--innovation-gate X]\n");
+               "[--write-poses] [--fixed-drift] [--drift-rule persistence|median|fixed] "
+               "[--innovation-gate X] [--initial-sigma-deg S] [--max-drift-deg M]\n");
   return 2;
 }
 
@@ -74,6 +79,9 @@ int main(int argc, char** argv) {
   bool paper_form = false;
   bool write_poses = false;
   bool fixed_drift = false;
+  std::string drift_rule;
+  double initial_sigma_deg = -1.0;
+  double max_drift_deg = -1.0;
   double innovation_gate = -1.0;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -99,6 +107,12 @@ int main(int argc, char** argv) {
       paper_form = true;
     } else if (a == "--write-poses") {
       write_poses = true;
+    } else if (a == "--max-drift-deg" && has_value) {
+      max_drift_deg = std::strtod(argv[++i], nullptr);
+    } else if (a == "--initial-sigma-deg" && has_value) {
+      initial_sigma_deg = std::strtod(argv[++i], nullptr);
+    } else if (a == "--drift-rule" && has_value) {
+      drift_rule = argv[++i];
     } else if (a == "--fixed-drift") {
       fixed_drift = true;
     } else if (a == "--innovation-gate" && has_value) {
@@ -122,7 +136,16 @@ int main(int argc, char** argv) {
   if (drift_deg >= 0.0) options.fusion.attitude_drift_deg_per_frame = drift_deg;
   if (sun_loss >= 0.0) options.fusion.loss_scale = sun_loss;
   options.fusion.estimate_base_attitude = !paper_form;
-  if (fixed_drift) options.fusion.adaptive_drift = false;
+  if (fixed_drift) options.fusion.drift_adaptation = sunvo::sunfusion::DriftAdaptation::kFixed;
+  if (initial_sigma_deg >= 0.0) options.fusion.initial_attitude_sigma_deg = initial_sigma_deg;
+  if (max_drift_deg >= 0.0) options.fusion.max_drift_deg_per_frame = max_drift_deg;
+  if (drift_rule == "median") {
+    options.fusion.drift_adaptation = sunvo::sunfusion::DriftAdaptation::kInnovationMedian;
+  } else if (drift_rule == "fixed") {
+    options.fusion.drift_adaptation = sunvo::sunfusion::DriftAdaptation::kFixed;
+  } else if (drift_rule != "persistence" && !drift_rule.empty()) {
+    return usage("--drift-rule needs persistence, median or fixed");
+  }
   if (innovation_gate >= 0.0) options.fusion.innovation_gate_chi2 = innovation_gate;
   if (auto s = options.validate(); !s.isOk()) return usage(s.toString());
   const auto sources = sunvo::experiment::defaultSunSources(static_cast<std::uint32_t>(seed));

@@ -44,7 +44,13 @@ struct ExperimentOptions {
   vo::VoOptions vo;
   int every_n_frames = 5;  // a sun measurement every n-th frame, [1, 1000]
   int max_frames = 0;      // 0 = the whole route; else the first max_frames frames, >= 0
-  sunfusion::SunFusionOptions fusion;  // gate and world_up are set per source / route
+  // Gate and world_up are set per source / route. VO starts at the ground-truth first pose, so the
+  // attitude is known at frame 0: its prior sigma is 0.1 deg instead of the generic 1 deg.
+  sunfusion::SunFusionOptions fusion = [] {
+    sunfusion::SunFusionOptions f;
+    f.initial_attitude_sigma_deg = 0.1;
+    return f;
+  }();
   Status validate() const;
 };
 

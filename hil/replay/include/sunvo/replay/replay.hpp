@@ -27,7 +27,13 @@ struct ReplayOptions {
   int every_n_frames = 5;         // a sun measurement every n-th frame, [1, 1000]
   int max_frames = 0;             // 0 = all
   pipeline::PipelineOptions pipeline;
-  sunfusion::SunFusionOptions fusion;
+  // The first camera pose comes from the first OXTS record (an RT3000-class INS: about 0.03 deg
+  // roll/pitch and 0.1 deg heading), so the attitude prior sigma is 0.1 deg, not the generic 1.
+  sunfusion::SunFusionOptions fusion = [] {
+    sunfusion::SunFusionOptions f;
+    f.initial_attitude_sigma_deg = 0.1;
+    return f;
+  }();
   Status validate() const;
 };
 
