@@ -98,6 +98,11 @@ TEST(RoverConfig, ErrorsNameTheFileTheKeyAndTheLine) {
                                       "pingpong"),
             std::string::npos);
 
+  auto drift = loadRoverConfig(path, {{"sun.max_drift_deg_per_frame", "0"}});
+  ASSERT_FALSE(drift);
+  EXPECT_EQ(drift.status().message(),
+            path + ": sun.max_drift_deg_per_frame: 0 is outside [0.002, 5]");
+
   auto q = loadRoverConfig(path, {{"queues.frames", "3"}});
   ASSERT_FALSE(q);
   EXPECT_NE(q.status().message().find("queues.frames: 3 is not a power of two"), std::string::npos);

@@ -668,6 +668,8 @@ Expected<std::unique_ptr<RoverApp>> RoverApp::create(const RoverConfig& config,
     fusion.world_up = Eigen::Vector3d::UnitZ();  // ENU
     fusion.estimate_base_attitude = config.sun.estimate_base_attitude;
     fusion.gate.max_cosine_distance = config.sun.max_cosine_distance;
+    fusion.initial_attitude_sigma_deg = config.sun.initial_attitude_sigma_deg;
+    fusion.max_drift_deg_per_frame = config.sun.max_drift_deg_per_frame;
     SUNVO_RETURN_IF_ERROR(impl->sun_term.init(fusion));
     impl->sun_term.attach(impl->vo.odometry().window());
   }

@@ -246,6 +246,9 @@ Status readAll(Reader& r, const YAML::Node& root, RoverConfig* c) {
   SUNVO_RETURN_IF_ERROR(r.get(n, "sun", "wait_ms", &s.wait_ms));
   SUNVO_RETURN_IF_ERROR(r.get(n, "sun", "estimate_base_attitude", &s.estimate_base_attitude));
   SUNVO_RETURN_IF_ERROR(r.get(n, "sun", "max_cosine_distance", &s.max_cosine_distance));
+  SUNVO_RETURN_IF_ERROR(
+      r.get(n, "sun", "initial_attitude_sigma_deg", &s.initial_attitude_sigma_deg));
+  SUNVO_RETURN_IF_ERROR(r.get(n, "sun", "max_drift_deg_per_frame", &s.max_drift_deg_per_frame));
   // serial
   SUNVO_RETURN_IF_ERROR(r.section(root, "", "serial", &n));
   SUNVO_RETURN_IF_ERROR(r.get(n, "serial", "device", &c->serial.device));
@@ -357,6 +360,10 @@ Status RoverConfig::validate() const {
   SUNVO_RETURN_IF_ERROR(checkOpenLow("sun.sigma", sun.sigma, 0.0, 2.0));
   SUNVO_RETURN_IF_ERROR(checkRange("sun.wait_ms", sun.wait_ms, 0, 100));
   SUNVO_RETURN_IF_ERROR(checkRange("sun.max_cosine_distance", sun.max_cosine_distance, 0, 2));
+  SUNVO_RETURN_IF_ERROR(
+      checkOpenLow("sun.initial_attitude_sigma_deg", sun.initial_attitude_sigma_deg, 0.0, 45.0));
+  SUNVO_RETURN_IF_ERROR(
+      checkRange("sun.max_drift_deg_per_frame", sun.max_drift_deg_per_frame, 0.002, 5.0));
   if (sun.provider == SunProviderType::kCsv && sun.csv.empty()) {
     return invalidArgument("sun.csv: empty, but sun.provider is csv");
   }

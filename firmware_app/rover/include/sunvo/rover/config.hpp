@@ -115,6 +115,11 @@ struct SunConfig {
                            //   sun frame's measurement (0 = never waits)
   bool estimate_base_attitude = true;  // see sunfusion::SunFusionOptions
   double max_cosine_distance = 0.3;    // gate, [0, 2]
+  // deg, (0, 45]: attitude std of the start pose (from the INS / level and heading at start-up)
+  double initial_attitude_sigma_deg = 1.0;
+  // deg/frame, [0.002, 5]: cap of the adapted attitude random walk (docs/experiment.md); raise it
+  // for a source whose errors are independent from frame to frame (a sun sensor)
+  double max_drift_deg_per_frame = 0.05;
 };
 
 struct SerialConfig {
