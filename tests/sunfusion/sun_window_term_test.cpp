@@ -72,6 +72,18 @@ class SunWindowTermTest : public ::testing::Test {
     ASSERT_TRUE(window_.solve());
   }
 
+  // 21 windows that all start from the same 2 deg base error: one term sees it through precise
+  // measurements (sigma 0.01, 0.57 deg), the other through imprecise ones (sigma 0.3, 17 deg).
+  void solvePreciseAndImprecise(const SunFusionOptions& opt, SunWindowTerm* precise,
+                                SunWindowTerm* imprecise) {
+    ASSERT_TRUE(precise->init(opt).isOk());
+    ASSERT_TRUE(imprecise->init(opt).isOk());
+    for (std::uint64_t k = 1; k <= 41; k += 2) {
+      solveAt(precise, k, perfectObservation(SunMeasurementKind::kFull3d, 0.01));
+      solveAt(imprecise, k, perfectObservation(SunMeasurementKind::kFull3d, 0.3));
+    }
+  }
+
   SunObservation perfectObservation(SunMeasurementKind kind, double sigma) const {
     SunObservation o;
     o.sun_w = sun_w_;
@@ -248,12 +260,7 @@ TEST_F(SunWindowTermTest, PersistenceRuleRaisesDriftOnlyWhenTheErrorStandsOutOfT
   opt.max_drift_deg_per_frame = 0.5;  // above the default cap, to see the rule itself
   ASSERT_EQ(opt.drift_adaptation, DriftAdaptation::kPersistence);
   SunWindowTerm precise, imprecise;
-  ASSERT_TRUE(precise.init(opt).isOk());
-  ASSERT_TRUE(imprecise.init(opt).isOk());
-  for (std::uint64_t k = 1; k <= 41; k += 2) {
-    solveAt(&precise, k, perfectObservation(SunMeasurementKind::kFull3d, 0.01));
-    solveAt(&imprecise, k, perfectObservation(SunMeasurementKind::kFull3d, 0.3));
-  }
+  solvePreciseAndImprecise(opt, &precise, &imprecise);
   EXPECT_GT(precise.persistenceStatistic(), 100.0);
   EXPECT_GT(precise.driftDegPerFrame(), 0.2);
   EXPECT_LE(precise.driftDegPerFrame(), opt.max_drift_deg_per_frame);
@@ -301,12 +308,7 @@ TEST_F(SunWindowTermTest, MedianRuleFollowsTheSizeOfTheInnovations) {
   opt.attitude_drift_deg_per_frame = 0.05;
   opt.max_drift_deg_per_frame = 0.5;
   SunWindowTerm precise, imprecise;
-  ASSERT_TRUE(precise.init(opt).isOk());
-  ASSERT_TRUE(imprecise.init(opt).isOk());
-  for (std::uint64_t k = 1; k <= 41; k += 2) {
-    solveAt(&precise, k, perfectObservation(SunMeasurementKind::kFull3d, 0.01));
-    solveAt(&imprecise, k, perfectObservation(SunMeasurementKind::kFull3d, 0.3));
-  }
+  solvePreciseAndImprecise(opt, &precise, &imprecise);
   EXPECT_GT(precise.driftDegPerFrame(), 0.2);
   EXPECT_LT(imprecise.driftDegPerFrame(), 0.01);
 }
