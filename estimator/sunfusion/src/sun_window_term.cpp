@@ -254,8 +254,12 @@ void SunWindowTerm::adaptDrift(const Innovation& inn, const Eigen::Matrix3d& C_w
       // T = g^T I^+ g with rank(I) dof when dtheta_w = 0 (noise only). The sums forget by
       // persistence_forgetting per measurement, so T weighs the recent drift; a Huber weight
       // caps an outlier's pull at persistence_huber sigmas per row.
-      const Eigen::MatrixXd H = inn.J.topRows(m) * C_w_b.transpose();
-      const Eigen::VectorXd r = inn.r.head(m);
+      // Fixed-size, with the rows past m zero (no heap allocation).
+      Eigen::Matrix3d J = inn.J;
+      Eigen::Vector3d r = inn.r;
+      J.bottomRows(3 - m).setZero();
+      r.tail(3 - m).setZero();
+      const Eigen::Matrix3d H = J * C_w_b.transpose();
       const double cap = options_.persistence_huber * std::sqrt(static_cast<double>(m));
       const double norm = r.norm();
       const double w = norm > cap ? cap / norm : 1.0;
