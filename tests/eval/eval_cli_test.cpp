@@ -2,9 +2,11 @@
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <random>
 #include <sstream>
@@ -18,7 +20,25 @@ namespace {
 const std::string kExe = SUNVO_EVAL_EXE;
 const std::string kGt = std::string(SUNVO_DATA_DIR) + "/kitti_odometry/00_gt_poses.txt";
 const std::string kTimes = std::string(SUNVO_DATA_DIR) + "/kitti_odometry/00_times.txt";
-const std::string kTmp = std::string(SUNVO_BINARY_DIR) + "/eval_cli_test_";
+// One prefix per process: ctest runs each test of this file as its own process, in parallel, and
+// they must not share the captured stdout/stderr or the scaled copy.
+const std::string kTmp =
+    std::string(SUNVO_BINARY_DIR) + "/eval_cli_test_" + std::to_string(::getpid()) + "_";
+
+// Removes this process's files when the tests end.
+class TmpCleanup : public ::testing::Environment {
+ public:
+  void TearDown() override {
+    const std::filesystem::path prefix(kTmp);
+    std::error_code ec;
+    for (const auto& e : std::filesystem::directory_iterator(prefix.parent_path(), ec)) {
+      if (e.path().filename().string().rfind(prefix.filename().string(), 0) == 0) {
+        std::filesystem::remove(e.path(), ec);
+      }
+    }
+  }
+};
+const auto* const kCleanup = ::testing::AddGlobalTestEnvironment(new TmpCleanup);
 
 struct CliResult {
   int code = -1;

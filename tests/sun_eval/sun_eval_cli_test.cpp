@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -13,7 +14,9 @@ namespace {
 namespace fs = std::filesystem;
 const std::string kExe = SUNVO_SUN_EVAL_EXE;
 const std::string kFrames = std::string(SUNVO_DATA_DIR) + "/kitti_odometry/00_first_frames";
-const std::string kOut = std::string(SUNVO_BINARY_DIR) + "/sun_eval_cli_test_out";
+// One folder per process: ctest runs the tests of this file in parallel processes.
+const std::string kOut =
+    std::string(SUNVO_BINARY_DIR) + "/sun_eval_cli_test_out_" + std::to_string(::getpid());
 
 std::string slurp(const std::string& path) {
   std::ifstream in(path);
@@ -47,6 +50,7 @@ TEST(SunEvalCli, EvaluatesTheRealKittiFrames) {
   // One header line and one line per frame.
   const std::string csv = slurp(kOut + "/frames/lalonde_vo_00_first_frames.csv");
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 12);
+  if (!::testing::Test::HasFailure()) fs::remove_all(kOut);  // kept for a look when it fails
 }
 
 TEST(SunEvalCli, RejectsBadArguments) {
