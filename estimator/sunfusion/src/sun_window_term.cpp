@@ -22,6 +22,21 @@ double chiSquareCdf(double x, int dof) {
   return e - std::sqrt(2.0 * x / M_PI) * std::exp(-0.5 * x);
 }
 
+// The sun residual of a measurement against the sun in the base frame: 3-D or azimuth-only, on
+// C_k_b alone (the paper's form) or also on the base correction delta_b.
+std::unique_ptr<ceres::CostFunction> makeSunCost(const Eigen::Vector3d& sun_b,
+                                                 const SunMeasurement& m, bool base_correction) {
+  if (m.kind == SunMeasurementKind::kAzimuthOnly) {
+    const Eigen::Vector2d xz = xzDirection(m.sun_c);
+    return std::unique_ptr<ceres::CostFunction>(
+        base_correction ? SunAzimuthResidual::CreateWithBaseCorrection(sun_b, xz, m.sigma)
+                        : SunAzimuthResidual::Create(sun_b, xz, m.sigma));
+  }
+  return std::unique_ptr<ceres::CostFunction>(
+      base_correction ? SunDirectionResidual::CreateWithBaseCorrection(sun_b, m.sun_c, m.sigma)
+                      : SunDirectionResidual::Create(sun_b, m.sun_c, m.sigma));
+}
+
 // x with chiSquareCdf(x, dof) = p, by bisection (p in (0, 1)).
 double chiSquareQuantile(double p, int dof) {
   double lo = 0.0, hi = 200.0;
@@ -131,13 +146,16 @@ Status SunWindowTerm::onSolve(backend::BundleWindow& window) {
     if (!used_[ring] || pending_[ring].obs.measurement.sequence != window.sequence(s)) continue;
     Pending& p = pending_[ring];
     const Eigen::Vector3d sun_b = C_b_w * p.obs.sun_w;
+    bool cost_built = false;  // p.cost already holds this solve's residual
     if (!p.decided) {
       const Eigen::Vector3d predicted_c = window.T_k_b(s).linear() * sun_b;
       const double up = p.obs.sun_w.dot(options_.world_up);
       GateResult r = gateSunMeasurement(options_.gate, predicted_c, up, p.obs.measurement);
       if (r == GateResult::kAccepted && estimate) {
+        p.cost = makeSunCost(sun_b, p.obs.measurement, true);
+        cost_built = true;
         Innovation inn;
-        const bool finite = innovation(window.T_k_b(s), sun_b, p.obs.measurement, P_b, &inn);
+        const bool finite = innovation(*p.cost, window.T_k_b(s), P_b, &inn);
         if (!finite ||
             (options_.innovation_gate_chi2 > 0.0 && inn.nis > options_.innovation_gate_chi2)) {
           r = GateResult::kRejectedInnovation;
@@ -152,20 +170,13 @@ Status SunWindowTerm::onSolve(backend::BundleWindow& window) {
     }
     if (!p.accepted || p.consumed) continue;
     // The base may have moved since the last solve (the window slid), so s_b is rebuilt each time.
-    const SunMeasurement& m = p.obs.measurement;
-    const bool azimuth = m.kind == SunMeasurementKind::kAzimuthOnly;
+    if (!cost_built) p.cost = makeSunCost(sun_b, p.obs.measurement, estimate);
     if (estimate) {
-      p.cost.reset(
-          azimuth
-              ? SunAzimuthResidual::CreateWithBaseCorrection(sun_b, xzDirection(m.sun_c), m.sigma)
-              : SunDirectionResidual::CreateWithBaseCorrection(sun_b, m.sun_c, m.sigma));
       double* extra[] = {delta_.data()};
       SUNVO_RETURN_IF_ERROR(window.addResidual(s, p.cost.get(), loss_.get(), extra));
       p.consumed = true;
       used_in_solve_[static_cast<std::size_t>(num_used_++)] = static_cast<int>(ring);
     } else {
-      p.cost.reset(azimuth ? SunAzimuthResidual::Create(sun_b, xzDirection(m.sun_c), m.sigma)
-                           : SunDirectionResidual::Create(sun_b, m.sun_c, m.sigma));
       SUNVO_RETURN_IF_ERROR(window.addPoseResidual(s, p.cost.get(), loss_.get()));
     }
   }
@@ -291,16 +302,11 @@ void SunWindowTerm::adaptDrift(const Innovation& inn, const Eigen::Matrix3d& C_w
                                     options_.max_drift_deg_per_frame);
 }
 
-bool SunWindowTerm::innovation(const Isometry3& T_k_b, const Eigen::Vector3d& sun_b,
-                               const SunMeasurement& m, const Eigen::Matrix3d& P_b,
-                               Innovation* out) const {
-  const bool azimuth = m.kind == SunMeasurementKind::kAzimuthOnly;
-  const std::unique_ptr<ceres::CostFunction> cost(
-      azimuth ? SunAzimuthResidual::CreateWithBaseCorrection(sun_b, xzDirection(m.sun_c), m.sigma)
-              : SunDirectionResidual::CreateWithBaseCorrection(sun_b, m.sun_c, m.sigma));
+bool SunWindowTerm::innovation(const ceres::CostFunction& cost, const Isometry3& T_k_b,
+                               const Eigen::Matrix3d& P_b, Innovation* out) {
   const double zero[3] = {0.0, 0.0, 0.0};
   int n = 0;
-  if (!evaluateAt(*cost, T_k_b, zero, &out->r, &out->J, &n) || n <= 0) return false;
+  if (!evaluateAt(cost, T_k_b, zero, &out->r, &out->J, &n) || n <= 0) return false;
   out->dof = n;
   const Eigen::MatrixXd J = out->J.topRows(n);
   const Eigen::MatrixXd S = J * P_b * J.transpose() + Eigen::MatrixXd::Identity(n, n);

@@ -139,8 +139,9 @@ class SunWindowTerm {
   static bool evaluateAt(const ceres::CostFunction& cost, const Isometry3& T_k_b,
                          const double* delta_b, Eigen::Vector3d* r,
                          Eigen::Matrix<double, 3, 3, Eigen::RowMajor>* J_d, int* m);
-  // A measurement's innovation at delta_b = 0: whitened residual r (dof rows) and its Jacobian
-  // J wrt delta_b; nis = r^T (J P_b J^T + I)^-1 r (innovation gate). False if not finite.
+  // A measurement's innovation at delta_b = 0, from its base-correction cost: whitened residual r
+  // (dof rows) and its Jacobian J wrt delta_b; nis = r^T (J P_b J^T + I)^-1 r (innovation gate).
+  // False if not finite.
   struct Innovation {
     Eigen::Vector3d r = Eigen::Vector3d::Zero();
     Eigen::Matrix<double, 3, 3, Eigen::RowMajor> J =
@@ -148,8 +149,8 @@ class SunWindowTerm {
     int dof = 0;
     double nis = 0.0;
   };
-  bool innovation(const Isometry3& T_k_b, const Eigen::Vector3d& sun_b, const SunMeasurement& m,
-                  const Eigen::Matrix3d& P_b, Innovation* out) const;
+  static bool innovation(const ceres::CostFunction& cost, const Isometry3& T_k_b,
+                         const Eigen::Matrix3d& P_b, Innovation* out);
   // One adaptation step of q_theta from an accepted measurement's innovation (C_w_b: base).
   void adaptDrift(const Innovation& inn, const Eigen::Matrix3d& C_w_b);
 
