@@ -12,6 +12,11 @@
 namespace sunvo::sunfusion {
 namespace {
 constexpr double kDeg = M_PI / 180.0;
+// A sun cost has 1 to 3 rows (azimuth-only or 3-D): dynamic sizes bounded by 3 keep the
+// storage on the stack, so the innovation and information updates do not touch the heap.
+using RowsJacobian = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor, 3, 3>;
+using RowsSquare = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 3, 3>;
+using RowsVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 3, 1>;
 
 // Chi-square CDF for 1, 2 or 3 degrees of freedom (closed forms).
 double chiSquareCdf(double x, int dof) {
@@ -207,7 +212,7 @@ void SunWindowTerm::onSolved(backend::BundleWindow& window) {
     Eigen::Vector3d r;
     int m = 0;
     if (!evaluateAt(*p.cost, window.T_k_b(slot), delta_.data(), &r, &J_d, &m)) continue;
-    const Eigen::MatrixXd J = J_d.topRows(m);
+    const RowsJacobian J = J_d.topRows(m);
     info_b += J.transpose() * J;
   }
   const Eigen::Vector3d delta_b(delta_[0], delta_[1], delta_[2]);
@@ -308,9 +313,9 @@ bool SunWindowTerm::innovation(const ceres::CostFunction& cost, const Isometry3&
   int n = 0;
   if (!evaluateAt(cost, T_k_b, zero, &out->r, &out->J, &n) || n <= 0) return false;
   out->dof = n;
-  const Eigen::MatrixXd J = out->J.topRows(n);
-  const Eigen::MatrixXd S = J * P_b * J.transpose() + Eigen::MatrixXd::Identity(n, n);
-  const Eigen::VectorXd rn = out->r.head(n);
+  const RowsJacobian J = out->J.topRows(n);
+  const RowsSquare S = J * P_b * J.transpose() + RowsSquare::Identity(n, n);
+  const RowsVector rn = out->r.head(n);
   out->nis = rn.dot(S.ldlt().solve(rn));
   return std::isfinite(out->nis);
 }
