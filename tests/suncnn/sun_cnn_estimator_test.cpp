@@ -135,6 +135,31 @@ TEST(SunCnnEstimator, MatchesPyTorchOnAFixedInput) {
   std::printf("OpenCV DNN vs PyTorch: max |difference| %.2e\n", max_diff);
 }
 
+// The defaults of SunCnnOptions repeat numbers of config/sun_cnn.json, which the training script
+// rewrites with every model: a retrained model with a stale default fails here.
+TEST(SunCnnEstimator, DefaultsMatchTheShippedModelsJson) {
+  const std::string path = std::string(SUNVO_SOURCE_DIR) + "/config/sun_cnn.json";
+  std::ifstream f(path);
+  ASSERT_TRUE(f.good()) << path;
+  std::stringstream text;
+  text << f.rdbuf();
+  const std::string json = text.str();
+  // The first number after "key": in the file (the keys are unique there).
+  auto number = [&](const std::string& key) {
+    const std::size_t at = json.find("\"" + key + "\":");
+    EXPECT_NE(at, std::string::npos) << path << ": no key " << key;
+    return at == std::string::npos ? std::nan("") : std::atof(json.c_str() + at + key.size() + 3);
+  };
+  const SunCnnOptions o;
+  EXPECT_NEAR(o.sigma_scale, number("sigma_scale"), 5e-5) << path << ": sigma_scale";
+  EXPECT_EQ(o.input_width, static_cast<int>(number("width")));
+  EXPECT_EQ(o.input_height, static_cast<int>(number("height")));
+  EXPECT_EQ(o.mask_rows, static_cast<int>(number("rows")));
+  EXPECT_EQ(o.mask1_size, static_cast<int>(number("mask1")));
+  EXPECT_EQ(o.mask2_size, static_cast<int>(number("mask2")));
+  EXPECT_DOUBLE_EQ(o.dropout_p, number("dropout_p"));
+}
+
 TEST(SunCnnEstimator, FindsTheSunOnHeldOutRenderedFrames) {
   auto est_ptr = shippedModel();
   SunCnnEstimator& est = *est_ptr;
