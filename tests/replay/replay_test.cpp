@@ -88,5 +88,16 @@ TEST(Replay, MissingDriveIsAClearError) {
   EXPECT_NE(options.validate().message().find("replay.every_n_frames"), std::string::npos);
 }
 
+TEST(Replay, ImageEstimatorCapIsValidated) {
+  ReplayOptions options;
+  options.drive_dir = "d";
+  EXPECT_TRUE(options.validate().isOk());
+  options.image_max_drift_deg_per_frame = 0.5 * options.fusion.min_drift_deg_per_frame;
+  EXPECT_NE(options.validate().message().find("replay.image_max_drift_deg_per_frame"),
+            std::string::npos);
+  options.image_max_drift_deg_per_frame = 6.0;
+  EXPECT_FALSE(options.validate().isOk());
+}
+
 }  // namespace
 }  // namespace sunvo::replay

@@ -4,10 +4,11 @@
 // top-view plot.
 //
 // Usage: sunvo_replay --drive DIR [--out DIR] [--frames N] [--every N] [--seed N]
-//                     [--drift-deg D] [--max-drift-deg M] [--paper-form]
-//                     [--estimators a,b,...] [--poses]
+//                     [--drift-deg D] [--max-drift-deg M] [--image-max-drift-deg M]
+//                     [--paper-form] [--estimators a,b,...] [--poses]
 //   --drift-deg   start value of the sun fusion's attitude random walk (deg/frame)
-//   --max-drift-deg  upper bound of the adapted random walk (deg/frame)
+//   --max-drift-deg  upper bound of the adapted random walk (deg/frame), error-model sources
+//   --image-max-drift-deg  the same for the image estimators (default 0.01)
 //   --estimators  also VO + sun from these image estimators (lalonde, lalonde_vo, sun_cnn) run
 //                 on the drive's colour images; "none" (default) runs the error-model sources
 //   --poses       also writes each run's estimated T_w_c as a KITTI pose file,
@@ -33,8 +34,8 @@ int usage(const std::string& msg) {
   std::fprintf(stderr, "sunvo_replay: %s\n", msg.c_str());
   std::fprintf(stderr,
                "usage: sunvo_replay --drive DIR [--out DIR] [--frames N] [--every N] [--seed N] "
-               "[--drift-deg D] [--max-drift-deg M] [--paper-form] [--estimators a,b,...] "
-               "[--poses]\n");
+               "[--drift-deg D] [--max-drift-deg M] [--image-max-drift-deg M] [--paper-form] "
+               "[--estimators a,b,...] [--poses]\n");
   return 2;
 }
 
@@ -86,6 +87,8 @@ int main(int argc, char** argv) {
       options.fusion.attitude_drift_deg_per_frame = std::strtod(argv[++i], nullptr);
     } else if (a == "--max-drift-deg" && has_value) {
       options.fusion.max_drift_deg_per_frame = std::strtod(argv[++i], nullptr);
+    } else if (a == "--image-max-drift-deg" && has_value) {
+      options.image_max_drift_deg_per_frame = std::strtod(argv[++i], nullptr);
     } else if (a == "--paper-form") {
       options.fusion.estimate_base_attitude = false;
     } else if (a == "--poses") {

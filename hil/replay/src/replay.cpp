@@ -19,7 +19,13 @@ Status ReplayOptions::validate() const {
   }
   if (max_frames < 0) return invalidArgument("replay.max_frames must be >= 0");
   SUNVO_RETURN_IF_ERROR(pipeline.validate());
-  return fusion.validate();
+  SUNVO_RETURN_IF_ERROR(fusion.validate());
+  if (!(image_max_drift_deg_per_frame >= fusion.min_drift_deg_per_frame &&
+        image_max_drift_deg_per_frame <= 5.0)) {
+    return invalidArgument("replay.image_max_drift_deg_per_frame out of range [" +
+                           std::to_string(fusion.min_drift_deg_per_frame) + ", 5]");
+  }
+  return Status::ok();
 }
 
 Expected<ReplayData> loadReplayData(const ReplayOptions& options) {
@@ -120,6 +126,7 @@ Expected<ReplayRun> replayDrive(const ReplayOptions& options,
     }
     sunfusion::SunFusionOptions fusion = options.fusion;
     fusion.world_up = Eigen::Vector3d::UnitZ();  // ENU
+    fusion.max_drift_deg_per_frame = options.image_max_drift_deg_per_frame;
     // An azimuth-only measurement (Sun-CNN) is gated in the x-z plane by gateSunMeasurement itself.
     SUNVO_RETURN_IF_ERROR(sun_term.init(fusion));
     sun_term.attach(vo.odometry().window());

@@ -117,9 +117,11 @@ struct SunConfig {
   double max_cosine_distance = 0.3;    // gate, [0, 2]
   // deg, (0, 45]: attitude std of the start pose (from the INS / level and heading at start-up)
   double initial_attitude_sigma_deg = 1.0;
-  // deg/frame, [0.002, 5]: cap of the adapted attitude random walk (docs/experiment.md); raise it
-  // for a source whose errors are independent from frame to frame (a sun sensor)
-  double max_drift_deg_per_frame = 0.05;
+  // deg/frame, [0.002, 5]: cap of the adapted attitude random walk (docs/experiment.md). 0.01
+  // for the image estimators, whose errors are correlated along a street (docs/sun_estimators.md,
+  // benchmark drives); raise it (0.05) for a source whose errors are independent from frame to
+  // frame (a sun sensor, the csv provider with the true sun)
+  double max_drift_deg_per_frame = 0.01;
 };
 
 struct SerialConfig {
