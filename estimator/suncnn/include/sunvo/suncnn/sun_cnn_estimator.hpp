@@ -47,7 +47,7 @@ struct SunCnnOptions {
   double dropout_p = 0.3;       // dropout probability used in training, [0, 0.9]
   int mc_samples = 16;          // N, MC dropout samples per image, [0, mask_rows - 1]; 0: R_mc = 1
   double sigma_scale = 0.4754;  // calibration factor on the spread sigma, (0, 100]; fitted
-                                // on the held-out renders (config/sun_cnn.json)
+                                // on the validation renders (config/sun_cnn.json)
   double sigma_min_rad = 0.03;  // floor of the reported sigma, rad, [0, 1]
   double sigma_max_rad = 3.0;   // cap of the reported sigma, rad, [sigma_min_rad, 10]
   double max_valid_sigma_rad = 0.5;  // above this the estimate is returned with valid = false,
