@@ -20,12 +20,17 @@ Status ReplayOptions::validate() const {
   if (max_frames < 0) return invalidArgument("replay.max_frames must be >= 0");
   SUNVO_RETURN_IF_ERROR(pipeline.validate());
   SUNVO_RETURN_IF_ERROR(fusion.validate());
-  if (!(image_max_drift_deg_per_frame >= fusion.min_drift_deg_per_frame &&
-        image_max_drift_deg_per_frame <= 5.0)) {
-    return invalidArgument("replay.image_max_drift_deg_per_frame out of range [" +
-                           std::to_string(fusion.min_drift_deg_per_frame) + ", 5]");
+  // The cap's range is the fusion's own (min <= cap <= 5), checked by the fusion itself.
+  if (const Status s = imageFusion().validate(); !s.isOk()) {
+    return invalidArgument("replay.image_max_drift_deg_per_frame: " + s.message());
   }
   return Status::ok();
+}
+
+sunfusion::SunFusionOptions ReplayOptions::imageFusion() const {
+  sunfusion::SunFusionOptions f = fusion;
+  f.max_drift_deg_per_frame = image_max_drift_deg_per_frame;
+  return f;
 }
 
 Expected<ReplayData> loadReplayData(const ReplayOptions& options) {
@@ -124,9 +129,8 @@ Expected<ReplayRun> replayDrive(const ReplayOptions& options,
     if (!source->colorCamera()) {
       return notFound(options.drive_dir + ": the image sun estimators need the colour images");
     }
-    sunfusion::SunFusionOptions fusion = options.fusion;
+    sunfusion::SunFusionOptions fusion = options.imageFusion();
     fusion.world_up = Eigen::Vector3d::UnitZ();  // ENU
-    fusion.max_drift_deg_per_frame = options.image_max_drift_deg_per_frame;
     // An azimuth-only measurement (Sun-CNN) is gated in the x-z plane by gateSunMeasurement itself.
     SUNVO_RETURN_IF_ERROR(sun_term.init(fusion));
     sun_term.attach(vo.odometry().window());

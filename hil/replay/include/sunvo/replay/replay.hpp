@@ -41,6 +41,8 @@ struct ReplayOptions {
   // the random walk's start value: on the three benchmark drives Sun-CNN made VO worse by up to
   // +246 % rot. ARMSE with 0.05, and by at most +0.5 % with 0.01 (docs/sun_estimators.md).
   double image_max_drift_deg_per_frame = 0.01;
+  // The fusion options of an image-estimator run: `fusion` with the cap above.
+  sunfusion::SunFusionOptions imageFusion() const;
   Status validate() const;
 };
 
