@@ -18,9 +18,11 @@ function(sunvo_library name)
   target_link_libraries(${name} PUBLIC ${ARG_DEPS} PRIVATE sunvo_warnings ${ARG_PRIVATE_DEPS})
 endfunction()
 
-# sunvo_executable(<name> SOURCES ... DEPS ...)
+# sunvo_executable(<name> SOURCES ... DEPS ...): a program. Every program lands in <build>/bin,
+# whichever folder its sources live in, so scripts and tests name it by its program name alone.
 function(sunvo_executable name)
   cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
   add_executable(${name} ${ARG_SOURCES})
+  set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/bin)
   target_link_libraries(${name} PRIVATE sunvo_warnings ${ARG_DEPS})
 endfunction()

@@ -11,16 +11,16 @@ jobs=$(nproc)
 cmake --preset release >/dev/null
 cmake --build --preset release -j "$jobs" \
   --target sunvo_experiment_cli sunvo_render_tool sunvo_replay_cli
-bin=build/release/hil
+bin=build/release/bin
 
-"$bin/experiment/sunvo_experiment" --out out/experiment
+"$bin/sunvo_experiment" --out out/experiment
 
 cache=build/release/render_cache/ci_short
 drive=$(ls -d "$cache"/*/*_drive_*_sync 2>/dev/null | head -n 1 || true)
 if [ -z "$drive" ] || [ ! -f "$drive/gt/poses_cam0_enu.txt" ] ||
    [ "$(ls "$drive/image_00/data" | wc -l)" -ne 100 ]; then
   rm -rf "$cache"
-  "$bin/render/sunvo_render" --scenario config/scenarios/ci_short.yaml --out "$cache" -j "$jobs"
+  "$bin/sunvo_render" --scenario config/scenarios/ci_short.yaml --out "$cache" -j "$jobs"
   drive=$(ls -d "$cache"/*/*_drive_*_sync | head -n 1)
 fi
-"$bin/replay/sunvo_replay" --drive "$drive" --out out/replay
+"$bin/sunvo_replay" --drive "$drive" --out out/replay

@@ -39,10 +39,10 @@ fi
 echo "machine load before the run: $(cut -d' ' -f1-3 /proc/loadavg) ($(nproc) CPUs)"
 timeout_s=$(( frames / 10 + 120 ))
 set +e
-"$bin/hil/pose_reader/sunvo_pose_reader" --drive "$drive" --frames "$frames" \
+"$bin/bin/sunvo_pose_reader" --drive "$drive" --frames "$frames" \
   --timeout-s "$timeout_s" --json "$out/reader.json" --child-log "$out/rover.log" \
   --latency-csv "$out/final_latency.csv" \
-  -- "$bin/firmware_app/main/sunvo_rover" --config config/rover_replay.yaml \
+  -- "$bin/bin/sunvo_rover" --config config/rover_replay.yaml \
   --set "source.kitti.drive_dir=$drive" --set "sun.csv=$drive/gt/sun_cam0.csv" \
   --set source.kitti.end=pingpong --set "source.kitti.total_frames=$frames" \
   --set "serial.device={pty}" --set "profiling.output_dir=$out" > "$out/reader.txt" 2>&1

@@ -16,15 +16,15 @@ drive=$(ls -d "$cache"/*/*_drive_*_sync 2>/dev/null | head -n 1 || true)
 if [[ -z "$drive" || ! -f "$drive/gt/poses_cam0_enu.txt" ]]; then
   echo "rendering the CI drive (100 frames, a few minutes) into $cache"
   rm -rf "$cache"
-  "$bin/hil/render/sunvo_render" --scenario config/scenarios/ci_short.yaml --out "$cache" -j "$(nproc)"
+  "$bin/bin/sunvo_render" --scenario config/scenarios/ci_short.yaml --out "$cache" -j "$(nproc)"
   drive=$(ls -d "$cache"/*/*_drive_*_sync | head -n 1)
 fi
 frames=$(wc -l < "$drive/image_00/timestamps.txt")
 out=out/rover_replay
 mkdir -p "$out"
-"$bin/hil/pose_reader/sunvo_pose_reader" --drive "$drive" --frames "$frames" --timeout-s 120 \
+"$bin/bin/sunvo_pose_reader" --drive "$drive" --frames "$frames" --timeout-s 120 \
   --json "$out/reader.json" --child-log "$out/rover.log" --latency-csv "$out/final_latency.csv" \
-  -- "$bin/firmware_app/main/sunvo_rover" --config config/rover_replay.yaml \
+  -- "$bin/bin/sunvo_rover" --config config/rover_replay.yaml \
   --set "source.kitti.drive_dir=$drive" --set "sun.csv=$drive/gt/sun_cam0.csv" \
   --set "serial.device={pty}" --set "profiling.output_dir=$out"
 status=$?

@@ -86,11 +86,11 @@ cmake --preset release -DSUNVO_DATA_DIR="${DATA_DIR}" >"${OUT}/configure-x86.log
 cmake --build build/release -j"${JOBS}" --target sunvo_track_vo
 args=(--frames "${FRAMES}" --max-time 100)
 t0=$(stamp)
-build/release/hil/track_vo/sunvo_track_vo "${TRACKS}" "${OUT}/poses_x86_64.txt" "${args[@]}" \
+build/release/bin/sunvo_track_vo "${TRACKS}" "${OUT}/poses_x86_64.txt" "${args[@]}" \
   >"${OUT}/track_vo_x86_64.log"
 echo "test_arm64: x86-64 track_vo $(elapsed "${t0}") s"
 t0=$(stamp)
-qemu-aarch64 -L "${SUNVO_SYSROOT}" build/aarch64/hil/track_vo/sunvo_track_vo "${TRACKS}" \
+qemu-aarch64 -L "${SUNVO_SYSROOT}" build/aarch64/bin/sunvo_track_vo "${TRACKS}" \
   "${OUT}/poses_aarch64.txt" "${args[@]}" >"${OUT}/track_vo_aarch64.log"
 echo "test_arm64: aarch64 (qemu) track_vo $(elapsed "${t0}") s"
 
@@ -163,11 +163,11 @@ cmake --build build/release -j"${JOBS}" --target sunvo_replay_cli
 replay_args=(--drive "${REPLAY_DRIVE}" --frames "${REPLAY_FRAMES}" --poses)
 rm -rf "${OUT}/replay_x86_64" "${OUT}/replay_aarch64"
 t0=$(stamp)
-build/release/hil/replay/sunvo_replay "${replay_args[@]}" --out "${OUT}/replay_x86_64" \
+build/release/bin/sunvo_replay "${replay_args[@]}" --out "${OUT}/replay_x86_64" \
   >"${OUT}/replay_x86_64.log" 2>&1
 echo "test_arm64: x86-64 replay $(elapsed "${t0}") s"
 t0=$(stamp)
-qemu-aarch64 -L "${SUNVO_SYSROOT}" build/aarch64/hil/replay/sunvo_replay "${replay_args[@]}" \
+qemu-aarch64 -L "${SUNVO_SYSROOT}" build/aarch64/bin/sunvo_replay "${replay_args[@]}" \
   --out "${OUT}/replay_aarch64" >"${OUT}/replay_aarch64.log" 2>&1
 echo "test_arm64: aarch64 (qemu) replay $(elapsed "${t0}") s"
 parity_fail=0

@@ -17,7 +17,7 @@ JOBS="${JOBS:-2}"
 PY=/usr/bin/python3  # Debian's interpreter, the one python3-torch is installed for
 MODE="${1:-all}"
 
-if [ ! -x "$BUILD/hil/render/sunvo_render" ]; then
+if [ ! -x "$BUILD/bin/sunvo_render" ]; then
   (cd "$ROOT" && cmake --preset release >/dev/null && cmake --build "$BUILD" --target sunvo_render_tool)
 fi
 
@@ -30,7 +30,7 @@ for yaml in "$ROOT"/config/scenarios/train_*.yaml "$ROOT"/config/scenarios/val_*
   if [ -f "$out/RENDERED" ] && [ "$(cat "$out/RENDERED")" = "$want" ]; then continue; fi
   rm -rf "$out"
   echo "train_sun_cnn: rendering $name"
-  nice -n 10 "$BUILD/hil/render/sunvo_render" --scenario "$yaml" --out "$out" -j "$JOBS"
+  nice -n 10 "$BUILD/bin/sunvo_render" --scenario "$yaml" --out "$out" -j "$JOBS"
   rm -rf "$out"/*/*_sync/pov   # POV-Ray sources and sky maps: not needed for training
   echo "$want" >"$out/RENDERED"
 done

@@ -21,7 +21,7 @@
 #include "sunvo/runtime/rt_setup.hpp"
 
 #ifdef SUNVO_ALLOC_COUNTER
-#include "sunvo/bench/alloc_counter.hpp"
+#include "sunvo/runtime/alloc_counter.hpp"
 #endif
 
 namespace {
@@ -90,7 +90,7 @@ int main(int argc, char** argv) {
     if (!w.empty()) std::fprintf(stderr, "sunvo_rover: %s\n", w.c_str());
   }
 #ifdef SUNVO_ALLOC_COUNTER
-  sunvo::runtime::setThreadAllocationProbe(&sunvo::bench::threadAllocationCount);
+  sunvo::runtime::setThreadAllocationProbe(&sunvo::runtime::threadAllocationCount);
 #endif
 
   // Signals are blocked in every thread (the threads inherit the mask) and taken here.

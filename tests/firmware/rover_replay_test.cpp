@@ -95,11 +95,11 @@ ProgramRun runProgram(const std::string& drive, int frames, const std::string& n
   const std::string emu = SUNVO_TOOL_EMULATOR;
   const std::string bin = SUNVO_BINARY_DIR;
   const std::string cmd =
-      emu + bin + "/hil/pose_reader/sunvo_pose_reader --drive " + drive + " --frames " +
+      emu + bin + "/bin/sunvo_pose_reader --drive " + drive + " --frames " +
       std::to_string(frames) + " --timeout-s 45 --json " + (out / "reader.json").string() +
       " --child-log " + (out / "rover.log").string() + " --latency-csv " +
       (out / "final_latency.csv").string() + " -- " + emu + bin +
-      "/firmware_app/main/sunvo_rover --config " + SUNVO_SOURCE_DIR +
+      "/bin/sunvo_rover --config " + SUNVO_SOURCE_DIR +
       "/config/rover_replay.yaml --set source.kitti.drive_dir=" + drive +
       " --set sun.csv=" + drive +
       "/gt/sun_cam0.csv --set serial.device={pty} --set profiling.output_dir=" + out.string() +

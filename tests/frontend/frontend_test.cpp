@@ -18,7 +18,7 @@
 #include "sunvo/frontend/stereo_frontend.hpp"
 
 #if defined(SUNVO_HAVE_ALLOC_COUNTER)
-#include "sunvo/bench/alloc_counter.hpp"
+#include "sunvo/runtime/alloc_counter.hpp"
 #endif
 
 namespace sunvo {
@@ -463,7 +463,7 @@ TEST_F(KittiFrontend, Deterministic) {
 
 TEST_F(KittiFrontend, NoHeapAllocationAfterTheFirstFrame) {
 #if defined(SUNVO_HAVE_ALLOC_COUNTER)
-  ASSERT_TRUE(bench::allocCounterActive());
+  ASSERT_TRUE(runtime::allocCounterActive());
   StereoFrontend fe;
   ASSERT_TRUE(fe.init(FrontendOptions{}, sample_->camera).isOk());
   FrameFeatures out;  // capacity not reserved: the first process() may allocate it
@@ -471,7 +471,7 @@ TEST_F(KittiFrontend, NoHeapAllocationAfterTheFirstFrame) {
   std::uint64_t total = 0;
   for (std::size_t i = 1; i < 30; ++i) {
     const std::size_t k = (i % 20) <= 10 ? i % 20 : 20 - i % 20;  // 1..10..0..9
-    bench::AllocationScope scope;
+    runtime::AllocationScope scope;
     const Status s = fe.process(sample_->frames[k].left, sample_->frames[k].right, 0, i, out);
     total += scope.count();
     ASSERT_TRUE(s.isOk());

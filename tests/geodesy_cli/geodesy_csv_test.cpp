@@ -74,7 +74,7 @@ TEST(GeodesyCsv, ErrorsNameLineAndField) {
 
 // The executable: exit 0 on good input, 2 on bad input, errors on stderr.
 TEST(GeodesyCli, ExitCodes) {
-  const std::string exe = std::string(SUNVO_BINARY_DIR) + "/hil/geodesy_cli/sunvo_geodesy";
+  const std::string exe = std::string(SUNVO_BINARY_DIR) + "/bin/sunvo_geodesy";
   ASSERT_TRUE(std::filesystem::exists(exe)) << exe;
   const auto dir =
       std::filesystem::temp_directory_path() / ("sunvo_geodesy_cli_" + std::to_string(::getpid()));

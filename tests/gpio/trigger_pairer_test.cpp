@@ -8,7 +8,7 @@
 #include <random>
 
 #if defined(SUNVO_HAVE_ALLOC_COUNTER)
-#include "sunvo/bench/alloc_counter.hpp"
+#include "sunvo/runtime/alloc_counter.hpp"
 #endif
 
 namespace sunvo::gpio {
@@ -150,9 +150,9 @@ TEST(TriggerPairer, TakesTheClosestTriggerInsideTheWindow) {
 
 TEST(TriggerPairer, AllocatesNothingPerCall) {
 #if defined(SUNVO_HAVE_ALLOC_COUNTER)
-  ASSERT_TRUE(bench::allocCounterActive());
+  ASSERT_TRUE(runtime::allocCounterActive());
   TriggerPairer pairer = make();
-  bench::AllocationScope scope;
+  runtime::AllocationScope scope;
   for (int k = 0; k < 1000; ++k) {
     if (k % 7 != 3) pairer.addTrigger({static_cast<std::uint64_t>(k), kT0 + k * kPeriod});
     if (k % 11 != 5) (void)pairer.matchFrame(kT0 + k * kPeriod + kDelay);

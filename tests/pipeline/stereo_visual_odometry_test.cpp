@@ -11,7 +11,7 @@
 #include "sunvo/files/trajectory_io.hpp"
 
 #if defined(SUNVO_HAVE_ALLOC_COUNTER)
-#include "sunvo/bench/alloc_counter.hpp"
+#include "sunvo/runtime/alloc_counter.hpp"
 #endif
 
 namespace sunvo::pipeline {
@@ -175,10 +175,10 @@ TEST_F(KittiPipeline, FrontendStageAllocatesNothingPerFrame) {
 #if !defined(SUNVO_HAVE_ALLOC_COUNTER)
   GTEST_SKIP() << "no allocation counter in this build";
 #else
-  ASSERT_TRUE(bench::allocCounterActive());
+  ASSERT_TRUE(runtime::allocCounterActive());
   StereoVisualOdometry vo;
   ASSERT_TRUE(vo.init(PipelineOptions{}, data_->camera).isOk());
-  vo.setStageCounter(&bench::allocationCount);
+  vo.setStageCounter(&runtime::allocationCount);
   std::uint64_t frontend = 0;
   std::uint64_t backend = 0;
   for (std::size_t i = 0; i < 30; ++i) {

@@ -1,6 +1,6 @@
 // The telemetry path of the firmware (pose -> ODOMETRY -> frame -> SerialPort) makes no heap
 // allocation after SerialPort::open, including when the port is full and frames are dropped.
-// Counted with the process-wide malloc shim of hil/bench (not available in sanitizer builds).
+// Counted with the process-wide malloc shim of firmware_app/alloc_counter (not available in sanitizer builds).
 
 #include <gtest/gtest.h>
 
@@ -8,7 +8,7 @@
 
 #include "../support/pty.hpp"
 #include "../support/telemetry.hpp"
-#include "sunvo/bench/alloc_counter.hpp"
+#include "sunvo/runtime/alloc_counter.hpp"
 #include "sunvo/mavlink/conventions.hpp"
 #include "sunvo/mavlink/mavlink.hpp"
 #include "sunvo/serial/serial_port.hpp"
@@ -21,7 +21,7 @@ using sunvo::testing::PseudoTerminal;
 using sunvo::testing::monotonicNs;
 
 TEST(TelemetryAlloc, CounterIsActive) {
-  EXPECT_TRUE(bench::allocCounterActive());
+  EXPECT_TRUE(runtime::allocCounterActive());
 }
 
 TEST(TelemetryAlloc, NoHeapAllocationAfterOpen) {
@@ -43,7 +43,7 @@ TEST(TelemetryAlloc, NoHeapAllocationAfterOpen) {
   std::size_t allocations = 0;
   std::uint8_t seq = 0;
   for (int k = 0; k < 600; ++k) {
-    const bench::AllocationScope scope;
+    const runtime::AllocationScope scope;
     // The firmware's telemetry step: pose -> ODOMETRY -> frame -> port, HEARTBEAT every 10th.
     in.time_ns = static_cast<TimeNs>(k) * 100'000'000;
     in.T_w_c.translation().x() = 0.1 * k;

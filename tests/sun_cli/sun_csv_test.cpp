@@ -133,7 +133,7 @@ TEST(SunCsv, OptionsValidateNamesKey) {
 // bad input.
 int runTool(const std::string& args, const std::string& err_path) {
   const std::string tool =
-      std::string(SUNVO_TOOL_EMULATOR) + SUNVO_BINARY_DIR + "/hil/sun_cli/sunvo_sun";
+      std::string(SUNVO_TOOL_EMULATOR) + SUNVO_BINARY_DIR + "/bin/sunvo_sun";
   const int rc = std::system((tool + " " + args + " 2>'" + err_path + "'").c_str());
   return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
 }

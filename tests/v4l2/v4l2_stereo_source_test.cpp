@@ -13,7 +13,7 @@
 #include "sunvo/v4l2/stereo_source.hpp"
 
 #if defined(SUNVO_HAVE_ALLOC_COUNTER)
-#include "sunvo/bench/alloc_counter.hpp"
+#include "sunvo/runtime/alloc_counter.hpp"
 #include "sunvo/sysio/sysio.hpp"
 #endif
 
@@ -454,7 +454,7 @@ TEST(V4l2StereoSource, DestructorStopsUnmapsAndCloses) {
 
 TEST(V4l2StereoSource, NoHeapAllocationPerFrameAfterTheFirst) {
 #if defined(SUNVO_HAVE_ALLOC_COUNTER)
-  ASSERT_TRUE(bench::allocCounterActive());
+  ASSERT_TRUE(runtime::allocCounterActive());
   for (V4l2Layout layout : {V4l2Layout::kTwoDevices, V4l2Layout::kSideBySide}) {
     for (V4l2PixelFormat format : {V4l2PixelFormat::kGrey, V4l2PixelFormat::kYuyv}) {
       Rig rig(layout);
@@ -469,7 +469,7 @@ TEST(V4l2StereoSource, NoHeapAllocationPerFrameAfterTheFirst) {
       // steps, in the driver or the emulated kernel, shows up.
       for (int k = 1; k <= 300; ++k) {
         rig.emu.trigger(kT0 + k * kPeriod);  // the emulated kernel's work is not counted
-        bench::AllocationScope scope;
+        runtime::AllocationScope scope;
         const Status s = source->next(frame);
         allocations += scope.count();
         ASSERT_TRUE(s.isOk());

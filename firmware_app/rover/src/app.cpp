@@ -80,7 +80,7 @@ Expected<WorldSetup> setUpWorld(const RoverConfig& c, const KittiReplaySource* k
     return w;
   }
   // From the drive's OXTS record of the first frame through the calibration chain, as the
-  // replay (hil/replay) does: ENU at that fix, camera 0 = T_w_imu * T_imu_cam0rect.
+  // replay (hil/tools/replay) does: ENU at that fix, camera 0 = T_w_imu * T_imu_cam0rect.
   const std::string& drive = c.source.kitti.drive_dir;
   auto oxts = kitti::readOxtsRecord(kitti::oxtsRecordPath(drive, c.source.kitti.first_frame));
   if (!oxts) return Status(oxts.status().code(), "world.init oxts: " + oxts.status().message());

@@ -2,7 +2,7 @@
 // The seam between sunvo's GPIO trigger code and libgpiod (v1.6 C API, Debian's libgpiod-dev).
 //
 // GpioApi wraps exactly the libgpiod calls the trigger code uses; LibgpiodApi forwards them to
-// libgpiod, and hil/emulated_devices' EmulatedGpio stands behind the same interface in tests.
+// libgpiod, and hil/sim/emulated_devices' EmulatedGpio stands behind the same interface in tests.
 // Every call returns 0 or an errno value (libgpiod itself returns -1 and sets errno). Handles are
 // opaque: each implementation decides what they point to.
 

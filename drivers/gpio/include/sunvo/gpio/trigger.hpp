@@ -1,7 +1,7 @@
 #pragma once
 // Camera trigger over GPIO: TriggerOutput drives a pulse train to the cameras' trigger inputs;
 // StrobeInput reads the cameras' strobe (exposure) edges with kernel timestamps. Both reach
-// libgpiod only through a GpioApi& (tests: hil/emulated_devices' EmulatedGpio).
+// libgpiod only through a GpioApi& (tests: hil/sim/emulated_devices' EmulatedGpio).
 // Neither owns a thread: the program's trigger thread calls them.
 
 #include <cstdint>

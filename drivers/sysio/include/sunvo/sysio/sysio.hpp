@@ -3,7 +3,7 @@
 //
 // Drivers (V4L2 today) reach the kernel only through a SysIo&: open, close, ioctl, mmap, munmap
 // and poll. linuxSysIo() forwards each call to the real syscall; tests and hardware-in-the-loop
-// runs put an emulated device behind the same interface (hil/emulated_devices), so the driver
+// runs put an emulated device behind the same interface (hil/sim/emulated_devices), so the driver
 // code that runs on the rover is the code the tests run.
 //
 // Every call reports failure as an errno value in the result (0 = success) instead of through

@@ -4,7 +4,7 @@
 // Two layouts: two devices (left and right cameras, each width x height) or one side-by-side
 // device (2*width x height, the left eye in the left half). Pixel formats GREY (8-bit) and YUYV
 // (4:2:2; the luma bytes are the gray image). The kernel is reached only through a
-// sysio::SysIo&, so tests run this code unchanged against hil/emulated_devices.
+// sysio::SysIo&, so tests run this code unchanged against hil/sim/emulated_devices.
 //
 // Life of a device: open(O_RDWR|O_NONBLOCK) → VIDIOC_QUERYCAP → S_FMT → S_PARM (frame rate)
 // → REQBUFS (MMAP) → QUERYBUF + mmap once per buffer → QBUF all → STREAMON; per frame poll (with

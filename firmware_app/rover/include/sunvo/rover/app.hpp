@@ -41,7 +41,7 @@ namespace sunvo::rover {
 
 // The kernel seams the V4L2 source and the GPIO trigger use (source.type v4l2, trigger.type
 // gpio). On the rover: sysio::linuxSysIo() and gpio::libgpiodApi(); tests pass the emulated
-// devices of hil/emulated_devices. Both must outlive the RoverApp.
+// devices of hil/sim/emulated_devices. Both must outlive the RoverApp.
 struct RoverDevices {
   sysio::SysIo* io = nullptr;
   gpio::GpioApi* gpio = nullptr;

@@ -7,7 +7,7 @@
 //   V4l2FrameSource (FrameSource): v4l2::V4l2StereoSource, each frame paired with its strobe
 //                  by gpio::TriggerPairer on the driver's buffer timestamp (same clock).
 // Both reach the kernel only through the seams they are given (sysio::SysIo, gpio::GpioApi), so
-// tests run this code on hil/emulated_devices.
+// tests run this code on hil/sim/emulated_devices.
 
 #include <memory>
 

@@ -1,7 +1,7 @@
 #pragma once
 // Heap allocations per frame of one thread after warm-up, for the real-time claims (0 per frame
 // in capture and telemetry). The count comes from a probe the executable installs (sunvo_rover
-// links hil/bench's counting malloc, whose per-thread counter it passes here); without a probe
+// links firmware_app/alloc_counter's counting malloc, whose per-thread counter it passes here); without a probe
 // the meter reports "not measured".
 
 #include <atomic>

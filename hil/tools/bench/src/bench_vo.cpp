@@ -29,7 +29,7 @@
 #include <string>
 #include <vector>
 
-#include "sunvo/bench/alloc_counter.hpp"
+#include "sunvo/runtime/alloc_counter.hpp"
 #include "sunvo/bench/bench_support.hpp"
 #include "sunvo/files/tracks_io.hpp"
 #include "sunvo/pipeline/stereo_visual_odometry.hpp"
@@ -80,7 +80,7 @@ void runPipeline(benchmark::State& state, bool use_window, Run& r) {
     state.SkipWithError(st.toString().c_str());
     return;
   }
-  vo.setStageCounter(&sunvo::bench::allocationCount);
+  vo.setStageCounter(&sunvo::runtime::allocationCount);
   const std::size_t n = g_data.frames.size();
   // Playback copies share the image buffers (cv::Mat headers); only sequence and time change so
   // that the back end sees a monotonic 10 Hz stream.
@@ -193,13 +193,13 @@ void benchTracks(benchmark::State& state) {
   std::size_t k = 0;
   bool failed = false;
   for (auto _ : state) {
-    const std::uint64_t a0 = sunvo::bench::allocationCount();
+    const std::uint64_t a0 = sunvo::runtime::allocationCount();
     const double cpu0 = sunvo::bench::threadCpuMs();
     const auto t0 = std::chrono::steady_clock::now();
     auto res = vo.process(g_track_seq.frames[k]);
     const auto t1 = std::chrono::steady_clock::now();
     const double cpu1 = sunvo::bench::threadCpuMs();
-    const std::uint64_t a1 = sunvo::bench::allocationCount();
+    const std::uint64_t a1 = sunvo::runtime::allocationCount();
     ++k;
     if (!res.hasValue()) {
       failed = true;
@@ -361,7 +361,7 @@ int main(int argc, char** argv) {
       rest.push_back(argv[i]);
     }
   }
-  auto data = sunvo::bench::prepareBenchmark(g_config, sunvo::bench::allocCounterActive());
+  auto data = sunvo::bench::prepareBenchmark(g_config, sunvo::runtime::allocCounterActive());
   if (!data) {
     std::fprintf(stderr, "%s\n", data.status().toString().c_str());
     return 1;

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "sunvo/bench/alloc_counter.hpp"
+#include "sunvo/runtime/alloc_counter.hpp"
 #include "sunvo/bench/bench_support.hpp"
 #include "sunvo/emulated/emulated_v4l2.hpp"
 #include "sunvo/metrics/metrics.hpp"
@@ -68,13 +68,13 @@ int runCase(V4l2Layout layout, V4l2PixelFormat format, int width, int height, in
   constexpr TimeNs kPeriod = 100'000'000;
   for (int k = 0; k <= frames; ++k) {
     emu.trigger(k * kPeriod);
-    const std::uint64_t allocs_before = sunvo::bench::allocationCount();
+    const std::uint64_t allocs_before = sunvo::runtime::allocationCount();
     const double c0 = threadCpuMs();
     const double w0 = wallMs();
     const sunvo::Status s = (*source)->next(frame);
     const double w1 = wallMs();
     const double c1 = threadCpuMs();
-    const std::uint64_t allocs = sunvo::bench::allocationCount() - allocs_before;
+    const std::uint64_t allocs = sunvo::runtime::allocationCount() - allocs_before;
     if (!s.isOk()) {
       std::fprintf(stderr, "frame %d: %s\n", k, s.toString().c_str());
       return 1;
@@ -113,7 +113,7 @@ int main(int argc, char** argv) {
                  "usage: sunvo_bench_v4l2 [--frames=N] [--width=W] [--height=H] [--cpu=K]\n");
     return 2;
   }
-  if (!sunvo::bench::allocCounterActive()) {
+  if (!sunvo::runtime::allocCounterActive()) {
     std::fprintf(stderr, "allocation counter not active\n");
     return 1;
   }

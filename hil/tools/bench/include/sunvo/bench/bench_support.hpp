@@ -27,7 +27,7 @@ struct BenchConfig {
 // Consumes one of the common flags into `config`; false when `arg` is not one of them.
 bool parseBenchFlag(const std::string& arg, BenchConfig& config);
 // Pins to config.cpu (when >= 0), fails when the allocation counter is not linked in (the
-// caller passes bench::allocCounterActive(), which only benchmark executables link), and loads
+// caller passes runtime::allocCounterActive(), which only benchmark executables link), and loads
 // the frames of config.data.
 Expected<KittiFrames> prepareBenchmark(const BenchConfig& config, bool alloc_counter_active);
 

@@ -8,7 +8,7 @@
 
 #include <cstdint>
 
-namespace sunvo::bench {
+namespace sunvo::runtime {
 
 // Allocation calls (malloc, calloc, realloc, the aligned forms, operator new) since start.
 std::uint64_t allocationCount();
@@ -29,4 +29,4 @@ class AllocationScope {
   std::uint64_t start_;
 };
 
-}  // namespace sunvo::bench
+}  // namespace sunvo::runtime

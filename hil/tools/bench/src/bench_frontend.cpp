@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "sunvo/bench/alloc_counter.hpp"
+#include "sunvo/runtime/alloc_counter.hpp"
 #include "sunvo/bench/bench_support.hpp"
 #include "sunvo/frontend/stereo_frontend.hpp"
 
@@ -49,9 +49,9 @@ sunvo::bench::KittiFrames g_sample;
 void benchFrontend(benchmark::State& state) {
   sunvo::StereoFrontend fe;
   sunvo::FrontendOptions opt;
-  const std::uint64_t bytes0 = sunvo::bench::allocatedBytes();
+  const std::uint64_t bytes0 = sunvo::runtime::allocatedBytes();
   const sunvo::Status st = fe.init(opt, g_sample.camera);
-  g_results.init_bytes = sunvo::bench::allocatedBytes() - bytes0;
+  g_results.init_bytes = sunvo::runtime::allocatedBytes() - bytes0;
   if (!st.isOk()) {
     state.SkipWithError(st.toString().c_str());
     return;
@@ -83,10 +83,10 @@ void benchFrontend(benchmark::State& state) {
     const std::size_t k = pingPong(frame, n);
     const auto t0 = std::chrono::steady_clock::now();
     const double cpu0 = threadCpuMs();
-    const std::uint64_t a0 = sunvo::bench::allocationCount();
+    const std::uint64_t a0 = sunvo::runtime::allocationCount();
     const sunvo::Status s =
         fe.process(g_sample.frames[k].left, g_sample.frames[k].right, 0, frame, out);
-    const std::uint64_t a1 = sunvo::bench::allocationCount();
+    const std::uint64_t a1 = sunvo::runtime::allocationCount();
     const double cpu1 = threadCpuMs();
     const auto t1 = std::chrono::steady_clock::now();
     if (!s.isOk()) failed = true;
@@ -180,7 +180,7 @@ int main(int argc, char** argv) {
       rest.push_back(argv[i]);
     }
   }
-  auto sample = sunvo::bench::prepareBenchmark(g_config, sunvo::bench::allocCounterActive());
+  auto sample = sunvo::bench::prepareBenchmark(g_config, sunvo::runtime::allocCounterActive());
   if (!sample) {
     std::fprintf(stderr, "%s\n", sample.status().toString().c_str());
     return 1;

@@ -1,4 +1,4 @@
-#include "sunvo/bench/alloc_counter.hpp"
+#include "sunvo/runtime/alloc_counter.hpp"
 
 #include <atomic>
 #include <cerrno>
@@ -176,7 +176,7 @@ void operator delete[](void* p, std::align_val_t, const std::nothrow_t&) noexcep
   free(p);
 }
 
-namespace sunvo::bench {
+namespace sunvo::runtime {
 
 std::uint64_t allocationCount() {
   return g_count.load(std::memory_order_relaxed);
@@ -198,4 +198,4 @@ bool allocCounterActive() {
   return counted;
 }
 
-}  // namespace sunvo::bench
+}  // namespace sunvo::runtime
