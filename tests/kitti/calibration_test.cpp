@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "temp_dir.hpp"
+#include "../support/temp_dir.hpp"
 
 namespace sunvo::kitti {
 namespace {

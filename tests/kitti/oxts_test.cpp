@@ -6,7 +6,7 @@
 #include <cstdlib>
 #include <sstream>
 
-#include "temp_dir.hpp"
+#include "../support/temp_dir.hpp"
 
 namespace sunvo::kitti {
 namespace {

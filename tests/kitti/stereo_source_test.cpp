@@ -7,8 +7,8 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include "../support/temp_dir.hpp"
 #include "sunvo/kitti/timestamps.hpp"
-#include "temp_dir.hpp"
 
 namespace sunvo::kitti {
 namespace {

@@ -62,8 +62,8 @@ Status KittiSourceOptions::validate() const {
     return invalidArgument("utc_offset_s: " + std::to_string(*utc_offset_s) +
                            " outside [-50400, 50400] s");
   }
-  if (odometry_start_time_ns && *odometry_start_time_ns <= 0) {
-    return invalidArgument("odometry_start_time_ns: must be > 0 (UTC ns of times.txt's 0)");
+  if (odometry_start_time_ns && *odometry_start_time_ns < 0) {
+    return invalidArgument("odometry_start_time_ns: must be >= 0 (UTC ns of times.txt's 0)");
   }
   if (first_frame < 0) return invalidArgument("first_frame: must be >= 0");
   if (last_frame < -1 || (last_frame != -1 && last_frame < first_frame)) {

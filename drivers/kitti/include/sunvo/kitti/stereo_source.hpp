@@ -62,7 +62,8 @@ struct KittiSourceOptions {
   // s, required for the raw layout, range [-50400, 50400]: offset of the files' zone to UTC
   // (+3600 = timestamps written in UTC+1). No default: the files name no zone.
   std::optional<std::int64_t> utc_offset_s;
-  // UTC ns of times.txt's 0, required for the odometry layout, > 0. No default.
+  // UTC ns of times.txt's 0, required for the odometry layout, >= 0. No default: 0 states that
+  // the UTC time is unknown (the frame times are then only relative).
   std::optional<TimeNs> odometry_start_time_ns;
   // Also deliver left_color/right_color (CV_8UC3) from image_02/03 (raw) or image_2/3
   // (odometry); open() fails when requested and absent.
