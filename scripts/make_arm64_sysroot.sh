@@ -24,7 +24,7 @@ mkdir -p "${DEBS}"
 DEV_PACKAGES=(
   libc6-dev libstdc++-12-dev
   libeigen3-dev libopencv-dev libceres-dev libgeographiclib-dev
-  libyaml-cpp-dev libgpiod-dev libgtest-dev libgmock-dev
+  libyaml-cpp-dev libcli11-dev libgpiod-dev libgtest-dev libgmock-dev
 )
 HOST_TOOLS=(crossbuild-essential-arm64 qemu-user)
 

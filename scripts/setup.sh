@@ -5,7 +5,7 @@ set -euo pipefail
 PACKAGES=(
   build-essential cmake ninja-build pkg-config git
   libeigen3-dev libopencv-dev libceres-dev libgeographiclib-dev
-  libgpiod-dev libyaml-cpp-dev libgtest-dev libgmock-dev libbenchmark-dev
+  libgpiod-dev libyaml-cpp-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-ephem povray
 )
 # node-mavlink (npm) decodes our MAVLink stream in the tests; installed only when node/npm is missing.

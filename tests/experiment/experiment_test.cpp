@@ -8,7 +8,7 @@ namespace {
 const std::string kData = SUNVO_DATA_DIR;
 
 TEST(Experiment, RealTracksRouteLoadsWithTruthAndSun) {
-  auto route = loadRealTrackRoute0020(kData);
+  auto route = loadRoute("0020", kData, {});
   ASSERT_TRUE(route) << route.status().toString();
   EXPECT_EQ(route->frames.size(), 1000u);
   EXPECT_EQ(route->T_w_c_gt.size(), 1000u);
@@ -20,7 +20,7 @@ TEST(Experiment, RealTracksRouteLoadsWithTruthAndSun) {
 }
 
 TEST(Experiment, TrueSunCutsRotationDriftOnRealTracks) {
-  auto route = loadRealTrackRoute0020(kData);
+  auto route = loadRoute("0020", kData, {});
   ASSERT_TRUE(route);
   ExperimentOptions opt;
   opt.max_frames = 400;
@@ -48,12 +48,15 @@ TEST(Experiment, TrueSunCutsRotationDriftOnRealTracks) {
 
 TEST(Experiment, SimulatedRouteUsesTheRealGroundTruthAndSun) {
   SimulatedRouteOptions sim;
-  auto route = loadSimulatedKittiRoute(kData, "06", sim);
+  auto route = loadRoute("06", kData, sim);
   ASSERT_TRUE(route) << route.status().toString();
   EXPECT_EQ(route->frames.size(), 1101u);
   EXPECT_EQ(route->sun_c_gt.size(), 1101u);
   EXPECT_NEAR(route->camera.fu, 707.0912, 1e-6);
-  EXPECT_FALSE(loadSimulatedKittiRoute(kData, "07", sim));
+  EXPECT_EQ(route->name, "06 = 2011_09_30_drive_0020 (simulated tracks)");
+  // Sequence 07 has a known rig but no files here; a folder that is no dataset fails too.
+  EXPECT_FALSE(loadRoute("07", kData, sim));
+  EXPECT_FALSE(loadRoute(kData + "/kitti_raw_sample", kData, sim));
 }
 
 TEST(Experiment, OptionsValidationNamesTheKey) {

@@ -98,9 +98,8 @@ ProgramRun runProgram(const std::string& drive, int frames, const std::string& n
       emu + bin + "/bin/sunvo_pose_reader --drive " + drive + " --frames " +
       std::to_string(frames) + " --timeout-s 45 --json " + (out / "reader.json").string() +
       " --child-log " + (out / "rover.log").string() + " --latency-csv " +
-      (out / "final_latency.csv").string() + " -- " + emu + bin +
-      "/bin/sunvo_rover --config " + SUNVO_SOURCE_DIR +
-      "/config/rover_replay.yaml --set source.kitti.drive_dir=" + drive +
+      (out / "final_latency.csv").string() + " -- " + emu + bin + "/bin/sunvo_rover --config " +
+      SUNVO_SOURCE_DIR + "/config/rover_replay.yaml --set source.kitti.drive_dir=" + drive +
       " --set sun.csv=" + drive +
       "/gt/sun_cam0.csv --set serial.device={pty} --set profiling.output_dir=" + out.string() +
       extra_sets + " > " + (out / "reader.txt").string() + " 2>&1";
@@ -140,16 +139,15 @@ TEST(RoverReplay, WholeProgramIntoAPseudoTerminal) {
 
   // Accuracy close to the sequential replay of the same frames with the same true sun.
   replay::ReplayOptions ro;
-  ro.drive_dir = drive;
-  ro.max_frames = frames;
-  auto data = replay::loadReplayData(ro);
+  ro.dataset.path = drive;
+  ro.dataset.last_frame = frames - 1;
+  auto data = replay::openReplayDataset(ro);
   ASSERT_TRUE(data) << data.status().toString();
-  data->T_w_c_gt.resize(static_cast<std::size_t>(frames));
-  auto seq = replay::replayDrive(ro, experiment::defaultSunSources(1)[0]);
+  auto seq = replay::replayDrive(*data, ro, experiment::defaultSunSources(1)[0]);
   ASSERT_TRUE(seq) << seq.status().toString();
   metrics::EvaluationOptions eo;
   eo.plane = metrics::HorizontalPlane::kEastNorth;
-  auto ev = metrics::evaluate(data->T_w_c_gt, seq->T_w_c, eo);
+  auto ev = metrics::evaluate(data->groundTruth(), seq->T_w_c, eo);
   ASSERT_TRUE(ev);
   const double drift_rover = jsonNumber(json, "final_drift_m");
   const double rot_rover = jsonNumber(json, "rot_armse_rad");

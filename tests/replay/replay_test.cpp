@@ -6,7 +6,7 @@
 
 #include "sunvo/metrics/metrics.hpp"
 #include "sunvo/render/drive.hpp"
-#include "sunvo/sun_estimators/sun_estimators.hpp"
+#include "sunvo/sunestimators/sun_estimators.hpp"
 
 namespace sunvo::replay {
 namespace {
@@ -25,50 +25,52 @@ TEST(Replay, RenderedDriveThroughTheWholeChain) {
   ASSERT_TRUE(drive) << drive.status().toString();
 
   ReplayOptions options;
-  options.drive_dir = *drive;
-  auto data = loadReplayData(options);
+  options.dataset.path = *drive;
+  auto data = openReplayDataset(options);
   ASSERT_TRUE(data) << data.status().toString();
-  ASSERT_EQ(data->T_w_c_gt.size(), 20u);
+  EXPECT_EQ(data->kind(), dataset::DatasetKind::kSunvoRender);
+  ASSERT_EQ(data->groundTruth().size(), 20u);
+  const std::vector<Isometry3>& gt = data->groundTruth();
 
-  auto pure = replayDrive(options, std::nullopt);
+  auto pure = replayDrive(*data, options, std::nullopt);
   ASSERT_TRUE(pure) << pure.status().toString();
   ASSERT_EQ(pure->T_w_c.size(), 20u);
   EXPECT_EQ(pure->lost_frames, 0);
   metrics::EvaluationOptions eval;
   eval.plane = metrics::HorizontalPlane::kEastNorth;
-  auto ev = metrics::evaluate(data->T_w_c_gt, pure->T_w_c, eval);
+  auto ev = metrics::evaluate(gt, pure->T_w_c, eval);
   ASSERT_TRUE(ev) << ev.status().toString();
   // The first pose comes from OXTS + calibration: it must match the truth closely.
-  EXPECT_LT((pure->T_w_c[0].translation() - data->T_w_c_gt[0].translation()).norm(), 0.01);
-  EXPECT_LT(rotationAngle(pure->T_w_c[0].linear() * data->T_w_c_gt[0].linear().transpose()), 0.001);
+  EXPECT_LT((pure->T_w_c[0].translation() - gt[0].translation()).norm(), 0.01);
+  EXPECT_LT(rotationAngle(pure->T_w_c[0].linear() * gt[0].linear().transpose()), 0.001);
   // Measured on this drive (20 frames): final drift 0.0145 m, rot. ARMSE 0.30e-3 rad.
   EXPECT_LT(ev->table1.final_drift_m, 0.1);
   EXPECT_LT(ev->table1.rot_armse_rad, 2e-3);
 
   // With the true sun the fusion runs (measurements offered every fifth frame) and stays accurate.
   const auto sources = experiment::defaultSunSources(1);
-  auto sun = replayDrive(options, sources[0]);
+  auto sun = replayDrive(*data, options, sources[0]);
   ASSERT_TRUE(sun) << sun.status().toString();
   EXPECT_EQ(sun->gate.total(), 3u);  // frames 5, 10, 15
   EXPECT_EQ(sun->gate.accepted, 3u);
-  auto ev_sun = metrics::evaluate(data->T_w_c_gt, sun->T_w_c, eval);
+  auto ev_sun = metrics::evaluate(gt, sun->T_w_c, eval);
   ASSERT_TRUE(ev_sun);
   EXPECT_LT(ev_sun->table1.rot_armse_rad, 2e-3);
   EXPECT_LT(ev_sun->table1.final_drift_m, 0.1);
 
   // An image estimator inside the pipeline: Sun-CNN on the colour images of frames 5, 10, 15.
-  auto cnn = suneval::makeSunEstimator("sun_cnn");
+  auto cnn = sunestimators::makeSunEstimator("sun_cnn", SUNVO_SOURCE_DIR "/config/sun_cnn.onnx");
   ASSERT_TRUE(cnn) << cnn.status().toString();
-  auto image_sun = replayDrive(options, std::nullopt, cnn->get());
+  auto image_sun = replayDrive(*data, options, std::nullopt, cnn->get());
   ASSERT_TRUE(image_sun) << image_sun.status().toString();
   EXPECT_EQ(image_sun->name, "VO+Sun (sun_cnn)");
   EXPECT_EQ(image_sun->sun_calls, 3);
   ASSERT_EQ(image_sun->T_w_c.size(), 20u);
   for (const Isometry3& T : image_sun->T_w_c) ASSERT_TRUE(T.matrix().allFinite());
-  EXPECT_FALSE(replayDrive(options, sources[0], cnn->get()));  // one source at a time
+  EXPECT_FALSE(replayDrive(*data, options, sources[0], cnn->get()));  // one source at a time
 
   // Deterministic replay.
-  auto again = replayDrive(options, std::nullopt);
+  auto again = replayDrive(*data, options, std::nullopt);
   ASSERT_TRUE(again);
   EXPECT_EQ(again->T_w_c.back().matrix(), pure->T_w_c.back().matrix());
   std::printf(
@@ -80,8 +82,8 @@ TEST(Replay, RenderedDriveThroughTheWholeChain) {
 
 TEST(Replay, MissingDriveIsAClearError) {
   ReplayOptions options;
-  options.drive_dir = "/nonexistent/drive_sync";
-  auto data = loadReplayData(options);
+  options.dataset.path = "/nonexistent/drive_sync";
+  auto data = openReplayDataset(options);
   ASSERT_FALSE(data);
   EXPECT_NE(data.status().message().find("/nonexistent/drive_sync"), std::string::npos);
   options.every_n_frames = 0;
@@ -90,7 +92,7 @@ TEST(Replay, MissingDriveIsAClearError) {
 
 TEST(Replay, ImageEstimatorCapIsValidated) {
   ReplayOptions options;
-  options.drive_dir = "d";
+  options.dataset.path = "d";
   EXPECT_TRUE(options.validate().isOk());
   options.image_max_drift_deg_per_frame = 0.5 * options.fusion.min_drift_deg_per_frame;
   EXPECT_NE(options.validate().message().find("replay.image_max_drift_deg_per_frame"),

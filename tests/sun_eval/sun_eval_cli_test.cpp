@@ -53,11 +53,20 @@ TEST(SunEvalCli, EvaluatesTheRealKittiFrames) {
   if (!::testing::Test::HasFailure()) fs::remove_all(kOut);  // kept for a look when it fails
 }
 
-TEST(SunEvalCli, RejectsBadArguments) {
+TEST(SunEvalCli, RejectsBadArgumentsAndInputs) {
+  // Usage errors exit 2, a bad input exits 1; --help and --version exit 0.
   EXPECT_EQ(run("--out " + kOut), 2);
   EXPECT_EQ(run("--images /nonexistent --out " + kOut), 2);
   EXPECT_EQ(run("--images " + kFrames + " --out " + kOut + " --estimators nope"), 2);
-  EXPECT_NE(slurp(kOut + "_stderr.txt").find("unknown sun estimator 'nope'"), std::string::npos);
+  EXPECT_NE(slurp(kOut + "_stderr.txt").find("nope"), std::string::npos);
+  EXPECT_EQ(run("--images " + kFrames + " --out " + kOut + " --frames x"), 2);
+  // A folder that is no dataset: a runtime failure naming it.
+  EXPECT_EQ(run("--images " + std::string(SUNVO_DATA_DIR) + " --out " + kOut), 1);
+  EXPECT_NE(slurp(kOut + "_stderr.txt").find("not a dataset"), std::string::npos);
+  EXPECT_EQ(run("--help"), 0);
+  EXPECT_NE(slurp(kOut + "_stdout.txt").find("--images"), std::string::npos);
+  EXPECT_EQ(run("--version"), 0);
+  EXPECT_NE(slurp(kOut + "_stdout.txt").find("sunvo_sun_eval"), std::string::npos);
 }
 
 }  // namespace

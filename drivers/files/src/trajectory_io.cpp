@@ -297,4 +297,9 @@ Status writeTumTrajectory(const std::string& path, const Trajectory& trajectory)
   return writeWholeFile(path, *text);
 }
 
+Status writeTrajectoryFiles(const std::string& base, const Trajectory& trajectory) {
+  SUNVO_RETURN_IF_ERROR(writeKittiPoses(base + ".txt", trajectory));
+  return writeTumTrajectory(base + "_tum.txt", trajectory);
+}
+
 }  // namespace sunvo::files

@@ -4,20 +4,12 @@
 #include <chrono>
 #include <cmath>
 
-#include "sunvo/files/sun_csv.hpp"
-#include "sunvo/files/text_file.hpp"
-#include "sunvo/files/tracks_io.hpp"
-#include "sunvo/files/trajectory_io.hpp"
-#include "sunvo/kitti/calibration.hpp"
+#include "sunvo/dataset/dataset.hpp"
+#include "sunvo/dataset/kitti_rigs.hpp"
+#include "sunvo/pipeline/sun_aided_odometry.hpp"
 #include "sunvo/simtracks/simulated_tracks.hpp"
 
 namespace sunvo::experiment {
-namespace {
-
-// The first camera frame of KITTI is level to within a few degrees: up is its -y axis.
-const Eigen::Vector3d kCameraWorldUp(0.0, -1.0, 0.0);
-
-}  // namespace
 
 Status ExperimentOptions::validate() const {
   SUNVO_RETURN_IF_ERROR(vo.validate());
@@ -34,23 +26,25 @@ Expected<RunResult> runRoute(const Route& route, const std::optional<SunSourceSp
   SUNVO_RETURN_IF_ERROR(options.validate());
   std::size_t n = route.frames.size();
   if (options.max_frames > 0) n = std::min(n, static_cast<std::size_t>(options.max_frames));
-  if (n < 2 || route.T_w_c_gt.size() < n || route.sun_c_gt.size() < n) {
+  if (n < 2 || route.T_w_c_gt.size() < n || route.sun_c_gt.size() < n || route.sun_w.size() < n) {
     return invalidArgument("experiment: route '" + route.name +
                            "' needs >= 2 frames with ground truth and sun for each");
   }
-  vo::StereoOdometry odometry;
-  SUNVO_RETURN_IF_ERROR(odometry.init(options.vo, route.camera, route.T_w_c_gt[0]));
-  sunfusion::SunWindowTerm sun_term;
+  pipeline::SunAidedOptions sao;
+  sao.pipeline.vo = options.vo;
+  sao.use_sun = spec.has_value();
+  sao.every_n_frames = options.every_n_frames;
+  sao.fusion = options.fusion;
+  sao.fusion.world_up = route.world_up;
   std::optional<sunfusion::SimulatedSunSource> source;
   if (spec) {
-    sunfusion::SunFusionOptions fusion = options.fusion;
-    fusion.gate = spec->gate;
-    fusion.world_up = kCameraWorldUp;
+    sao.fusion.gate = spec->gate;
     SUNVO_RETURN_IF_ERROR(spec->model.validate());
-    SUNVO_RETURN_IF_ERROR(sun_term.init(fusion));
-    sun_term.attach(odometry.window());
     source.emplace(spec->model);
   }
+  pipeline::SunAidedOdometry odometry;
+  SUNVO_RETURN_IF_ERROR(
+      odometry.init(sao, route.camera, route.T_w_c_gt[0], pipeline::OdometryInput::kFeatures));
 
   RunResult result;
   result.name = spec ? spec->name : "Pure VO";
@@ -59,14 +53,9 @@ Expected<RunResult> runRoute(const Route& route, const std::optional<SunSourceSp
   ms.reserve(n);
   for (std::size_t k = 0; k < n; ++k) {
     const FrameFeatures& frame = route.frames[k];
-    if (source && k > 0 && k % static_cast<std::size_t>(options.every_n_frames) == 0) {
+    if (source && odometry.isSunFrame(frame.sequence)) {
       auto m = source->measure(frame.sequence, frame.time_ns, route.sun_c_gt[k]);
-      if (m) {
-        sunfusion::SunObservation obs;
-        obs.measurement = *m;
-        obs.sun_w = (route.T_w_c_gt[k].linear() * route.sun_c_gt[k]).normalized();
-        sun_term.addObservation(obs);
-      }
+      if (m) odometry.addSun({*m, route.sun_w[k]});
     }
     const auto t0 = std::chrono::steady_clock::now();
     auto r = odometry.process(frame);
@@ -76,7 +65,7 @@ Expected<RunResult> runRoute(const Route& route, const std::optional<SunSourceSp
     ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
     result.T_w_c.push_back(r->T_w_c);
   }
-  result.gate = sun_term.counters();
+  result.gate = odometry.sunCounters();
   result.median_ms = metrics::percentile(ms, 0.5);
   result.p99_ms = metrics::percentile(ms, 0.99);
   const std::vector<Isometry3> gt(route.T_w_c_gt.begin(),
@@ -140,71 +129,49 @@ std::vector<SunSourceSpec> defaultSunSources(std::uint32_t seed) {
   return specs;
 }
 
-Expected<Route> loadRealTrackRoute0020(const std::string& data_dir) {
-  const std::string dir = data_dir + "/kitti_tracks/2011_09_30_drive_0020";
-  auto seq = files::readTrackFolder(dir, files::TrackReadOptions{});
-  if (!seq) return seq.status();
-  if (seq->gt_T_0_k.size() != seq->frames.size()) {
-    return notFound(dir + "/gt_poses.txt: ground truth required for the experiment");
+Expected<Route> loadRoute(const std::string& spec, const std::string& data_dir,
+                          const SimulatedRouteOptions& options) {
+  dataset::DatasetOptions dopt;
+  std::string name;
+  if (spec == "0020") {
+    dopt.path = data_dir + "/kitti_tracks/2011_09_30_drive_0020";
+    dopt.sun_csv = data_dir + "/kitti_odometry/06_sun_cam.csv";
+    name = "2011_09_30_drive_0020";
+  } else if (const auto drive = dataset::kittiOdometryDrive(spec)) {
+    dopt.path = data_dir + "/kitti_odometry/" + spec;
+    name = spec + " = " + *drive;
+  } else {
+    dopt.path = spec;
   }
-  auto sun = files::readSunCsv(data_dir + "/kitti_odometry/06_sun_cam.csv");
-  if (!sun) return sun.status();
-  if (sun->sun_c.size() < seq->frames.size()) {
-    return invalidArgument("06_sun_cam.csv has fewer rows than the 0020 tracks have frames");
+  auto ds = dataset::Dataset::open(dopt);
+  if (!ds) return ds.status();
+  if (name.empty()) name = ds->name();
+  if (!ds->hasGroundTruth()) return notFound(dopt.path + ": the experiment needs ground truth");
+  if (!ds->sunKnown()) {
+    return notFound(dopt.path + ": the experiment needs the true sun: " + ds->sunUnknownReason());
   }
   Route route;
-  route.name = "2011_09_30_drive_0020 (real tracks)";
-  route.camera = seq->camera;
-  route.frames = std::move(seq->frames);
-  route.T_w_c_gt = std::move(seq->gt_T_0_k);
-  route.sun_c_gt.assign(sun->sun_c.begin(),
-                        sun->sun_c.begin() + static_cast<std::ptrdiff_t>(route.frames.size()));
-  return route;
-}
-
-Expected<Route> loadSimulatedKittiRoute(const std::string& data_dir, const std::string& seq,
-                                        const SimulatedRouteOptions& options) {
-  StereoCamera camera;
-  std::string drive;
-  if (seq == "00") {
-    auto calib =
-        kitti::readOdometryCalibration(data_dir + "/kitti_odometry/00_first_frames/calib.txt");
-    if (!calib) return calib.status();
-    auto cam = kitti::odometryStereoCamera(*calib, 0, 1, 1241, 376);
-    if (!cam) return cam.status();
-    camera = *cam;
-    drive = "2011_10_03_drive_0027";
-  } else if (seq == "06") {
-    // Sequence 06 is raw drive 2011_09_30_drive_0020: the track folder holds its calibration.
-    auto file = files::TextFile::open(data_dir + "/kitti_tracks/2011_09_30_drive_0020/calib.txt");
-    if (!file) return file.status();
-    auto cam = files::parseTrackCalib(*file, 1226, 370);
-    if (!cam) return cam.status();
-    camera = *cam;
-    drive = "2011_09_30_drive_0020";
-  } else {
-    return invalidArgument("experiment: unknown simulated route '" + seq + "' (00 or 06)");
+  route.camera = ds->camera();
+  route.T_w_c_gt = ds->groundTruth();
+  route.times_ns = ds->timesNs();
+  route.world_up = ds->worldUp();
+  for (const dataset::TrueSun& s : ds->trueSun()) {
+    route.sun_c_gt.push_back(s.sun_c);
+    route.sun_w.push_back(s.sun_w);
   }
-  const std::string base = data_dir + "/kitti_odometry/" + seq;
-  auto gt = files::loadTrajectory(base + "_gt_poses.txt", base + "_times.txt");
-  if (!gt) return gt.status();
-  auto sun = files::readSunCsv(base + "_sun_cam.csv");
-  if (!sun) return sun.status();
-  if (sun->sun_c.size() != gt->size()) {
-    return invalidArgument(base + "_sun_cam.csv: row count differs from the ground truth");
+  if (ds->hasFeatures()) {
+    route.name = name + " (real tracks)";
+    route.frames = ds->features();
+    return route;
   }
   simtracks::SimTrackOptions sim;
   sim.seed = options.seed;
   sim.pixel_noise_px = options.pixel_noise_px;
   sim.outlier_share = options.outlier_share;
-  auto frames = simtracks::simulateTracks(gt->T_w_c, gt->t_ns, camera, sim);
+  auto frames = simtracks::simulateTracks(route.T_w_c_gt, ds->timesNs(), route.camera, sim);
   if (!frames) return frames.status();
-  Route route;
-  route.name = seq + " = " + drive + " (simulated tracks)";
-  route.camera = camera;
+  route.name = name + " (simulated tracks)";
   route.frames = std::move(*frames);
-  route.T_w_c_gt = gt->T_w_c;
-  route.sun_c_gt = sun->sun_c;
   return route;
 }
 

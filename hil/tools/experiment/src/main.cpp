@@ -1,24 +1,9 @@
 // sunvo_experiment: the paper's experiment in one command. Pure VO against VO + sun from several
 // sun sources (the true vector and error models emulating Lalonde, Lalonde-VO and Sun-CNN), on the
 // real 2011_09_30_drive_0020 feature tracks and on simulated tracks along the real routes 00 and
-// 06. Per route: a Table-1-style markdown table and JSON, and a top-view plot (PNG).
-//
-// Usage: sunvo_experiment [--data DIR] [--out DIR] [--routes 0020,00,06] [--frames N]
-//                         [--every N] [--seed N] [--drift-deg D] [--sun-loss S] [--paper-form]
-//                         [--write-poses] [--fixed-drift] [--drift-rule R]
-//                         [--innovation-gate X] [--initial-sigma-deg S] [--max-drift-deg M]
-//   --drift-deg   attitude random walk of VO per frame for the sun fusion (deg; the start value
-//                 when it adapts)
-//   --sun-loss    Cauchy scale on the whitened sun residual (0 = none)
-//   --paper-form  hold the base attitude fixed, as the paper did
-//   --fixed-drift keep the attitude random walk at --drift-deg instead of adapting it
-//   --drift-rule  how the random walk adapts: persistence (default), median or fixed
-//   --innovation-gate  chi-square bound of the innovation gate (0 = off)
-//   --max-drift-deg  upper bound of the adapted random walk (deg/frame)
-//   --initial-sigma-deg  prior sigma of the first pose's attitude (deg; default 0.1, since VO
-//                 starts at the ground-truth pose)
-//   --write-poses also write every run's poses and the ground truth as KITTI pose files
-//                 (route_<id>_gt.txt, route_<id>_run<i>.txt; run 0 is pure VO, then the sources)
+// 06 (any route by --routes: a KITTI odometry sequence id or a dataset path, see loadRoute). Per
+// route: a Table-1-style markdown table and JSON, and a top-view plot (PNG). --help lists the
+// options.
 
 #include <cstdio>
 #include <cstdlib>
@@ -27,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "sunvo/cli/cli.hpp"
 #include "sunvo/experiment/experiment.hpp"
 #include "sunvo/files/trajectory_io.hpp"
 #include "sunvo/report/report_files.hpp"
@@ -35,24 +21,7 @@ namespace {
 
 using sunvo::experiment::Route;
 using sunvo::experiment::RunResult;
-
-int usage(const std::string& msg) {
-  std::fprintf(stderr, "sunvo_experiment: %s\n", msg.c_str());
-  std::fprintf(stderr,
-               "usage: sunvo_experiment [--data DIR] [--out DIR] [--routes 0020,00,06] "
-               "[--frames N] [--every N] [--seed N] [--drift-deg D] [--sun-loss S] [--paper-form] "
-               "[--write-poses] [--fixed-drift] [--drift-rule persistence|median|fixed] "
-               "[--innovation-gate X] [--initial-sigma-deg S] [--max-drift-deg M]\n");
-  return 2;
-}
-
-bool parseInt(const char* text, int& out) {
-  char* end = nullptr;
-  const long v = std::strtol(text, &end, 10);
-  if (end == text || *end != '\0' || v < 0 || v > 1'000'000) return false;
-  out = static_cast<int>(v);
-  return true;
-}
+constexpr const char* kProgram = "sunvo_experiment";
 
 std::vector<std::string> splitComma(const std::string& s) {
   std::vector<std::string> out;
@@ -68,6 +37,16 @@ double pctChange(double base, double value) {
   return 100.0 * (value - base) / base;
 }
 
+// A file-name-safe id of a route spec: "0020", "00", or the last path component.
+std::string routeId(const std::string& spec) {
+  std::string id = std::filesystem::path(spec).filename().string();
+  if (id.empty()) id = std::filesystem::path(spec).parent_path().filename().string();
+  for (char& c : id) {
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-')) c = '_';
+  }
+  return id;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -75,57 +54,54 @@ int main(int argc, char** argv) {
   std::string out_dir = "experiment_out";
   std::string routes_arg = "0020,00,06";
   int frames = 0, every = 5, seed = 1;
-  double drift_deg = -1.0, sun_loss = -1.0;
+  std::optional<double> drift_deg, sun_loss, initial_sigma_deg, max_drift_deg, innovation_gate;
   bool paper_form = false;
   bool write_poses = false;
   bool fixed_drift = false;
-  std::string drift_rule;
-  double initial_sigma_deg = -1.0;
-  double max_drift_deg = -1.0;
-  double innovation_gate = -1.0;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    const bool has_value = i + 1 < argc;
-    if (a == "--help" || a == "-h") {
-      usage("help");
-      return 0;
-    } else if (a == "--data" && has_value) {
-      data_dir = argv[++i];
-    } else if (a == "--out" && has_value) {
-      out_dir = argv[++i];
-    } else if (a == "--routes" && has_value) {
-      routes_arg = argv[++i];
-    } else if (a == "--frames" && has_value) {
-      if (!parseInt(argv[++i], frames)) return usage("--frames needs a count >= 0");
-    } else if (a == "--every" && has_value) {
-      if (!parseInt(argv[++i], every) || every < 1) return usage("--every needs a count >= 1");
-    } else if (a == "--drift-deg" && has_value) {
-      drift_deg = std::strtod(argv[++i], nullptr);
-    } else if (a == "--sun-loss" && has_value) {
-      sun_loss = std::strtod(argv[++i], nullptr);
-    } else if (a == "--paper-form") {
-      paper_form = true;
-    } else if (a == "--write-poses") {
-      write_poses = true;
-    } else if (a == "--max-drift-deg" && has_value) {
-      max_drift_deg = std::strtod(argv[++i], nullptr);
-    } else if (a == "--initial-sigma-deg" && has_value) {
-      initial_sigma_deg = std::strtod(argv[++i], nullptr);
-    } else if (a == "--drift-rule" && has_value) {
-      drift_rule = argv[++i];
-    } else if (a == "--fixed-drift") {
-      fixed_drift = true;
-    } else if (a == "--innovation-gate" && has_value) {
-      innovation_gate = std::strtod(argv[++i], nullptr);
-    } else if (a == "--seed" && has_value) {
-      if (!parseInt(argv[++i], seed)) return usage("--seed needs a number >= 0");
-    } else {
-      return usage("unknown or incomplete argument '" + a + "'");
-    }
-  }
+  std::string drift_rule = "persistence";
+  CLI::App app{
+      "The paper's experiment: pure VO against VO + sun from several sun sources, per route.",
+      kProgram};
+  app.add_option("--data", data_dir, "folder of the real data (shared/data layout)");
+  app.add_option("--out", out_dir, "output folder (created)");
+  app.add_option("--routes", routes_arg,
+                 "comma-separated routes: 0020 (real tracks), a KITTI odometry id (00..10: "
+                 "DATA/kitti_odometry/NN_*), or a dataset path");
+  app.add_option("--frames", frames, "first N frames of each route (0 = all)")
+      ->check(CLI::Range(0, 1000000));
+  app.add_option("--every", every, "a sun measurement every N-th frame")
+      ->check(CLI::Range(1, 1000));
+  app.add_option("--seed", seed, "seed of the simulated tracks and the error models")
+      ->check(CLI::Range(0, 1000000));
+  app.add_option("--drift-deg", drift_deg,
+                 "attitude random walk per frame, deg (its start value when it adapts)")
+      ->check(CLI::Range(0.0, 5.0));
+  app.add_option("--sun-loss", sun_loss, "Cauchy scale on the whitened sun residual (0 = none)")
+      ->check(CLI::Range(0.0, 100.0));
+  app.add_flag("--paper-form", paper_form, "hold the base attitude fixed, as the paper did");
+  app.add_flag("--fixed-drift", fixed_drift, "keep the random walk at --drift-deg");
+  app.add_option("--drift-rule", drift_rule, "how the random walk adapts")
+      ->check(CLI::IsMember({"persistence", "median", "fixed"}));
+  app.add_option("--innovation-gate", innovation_gate,
+                 "chi-square bound of the innovation gate (0 = off)")
+      ->check(CLI::Range(0.0, 1e6));
+  app.add_option("--initial-sigma-deg", initial_sigma_deg,
+                 "prior sigma of the first pose's attitude, deg (default 0.1: VO starts at the "
+                 "ground-truth pose)")
+      ->check(CLI::Range(0.0, 45.0));
+  app.add_option("--max-drift-deg", max_drift_deg,
+                 "upper bound of the adapted random walk, deg/frame")
+      ->check(CLI::Range(0.0, 5.0));
+  app.add_flag("--write-poses", write_poses,
+               "also write every run's poses and the ground truth as KITTI and TUM files "
+               "(route_<id>_gt, route_<id>_run<i>; run 0 is pure VO, then the sources)");
+  if (auto code = sunvo::cli::parse(app, argc, argv)) return *code;
+
   std::error_code ec;
   std::filesystem::create_directories(out_dir, ec);
-  if (ec) return usage("cannot create output folder '" + out_dir + "': " + ec.message());
+  if (ec)
+    return sunvo::cli::fail(kProgram,
+                            "cannot create output folder '" + out_dir + "': " + ec.message());
 
   sunvo::experiment::ExperimentOptions options;
   options.every_n_frames = every;
@@ -133,49 +109,41 @@ int main(int argc, char** argv) {
   // A replay is bounded by solver iterations only: a wall-clock limit would make the result
   // depend on the machine's load. (The onboard program keeps its time budget.)
   options.vo.window.max_solver_time_in_seconds = 60.0;
-  if (drift_deg >= 0.0) options.fusion.attitude_drift_deg_per_frame = drift_deg;
-  if (sun_loss >= 0.0) options.fusion.loss_scale = sun_loss;
+  if (drift_deg) options.fusion.attitude_drift_deg_per_frame = *drift_deg;
+  if (sun_loss) options.fusion.loss_scale = *sun_loss;
   options.fusion.estimate_base_attitude = !paper_form;
   if (fixed_drift) options.fusion.drift_adaptation = sunvo::sunfusion::DriftAdaptation::kFixed;
-  if (initial_sigma_deg >= 0.0) options.fusion.initial_attitude_sigma_deg = initial_sigma_deg;
-  if (max_drift_deg >= 0.0) options.fusion.max_drift_deg_per_frame = max_drift_deg;
+  if (initial_sigma_deg) options.fusion.initial_attitude_sigma_deg = *initial_sigma_deg;
+  if (max_drift_deg) options.fusion.max_drift_deg_per_frame = *max_drift_deg;
   if (drift_rule == "median") {
     options.fusion.drift_adaptation = sunvo::sunfusion::DriftAdaptation::kInnovationMedian;
   } else if (drift_rule == "fixed") {
     options.fusion.drift_adaptation = sunvo::sunfusion::DriftAdaptation::kFixed;
-  } else if (drift_rule != "persistence" && !drift_rule.empty()) {
-    return usage("--drift-rule needs persistence, median or fixed");
   }
-  if (innovation_gate >= 0.0) options.fusion.innovation_gate_chi2 = innovation_gate;
-  if (auto s = options.validate(); !s.isOk()) return usage(s.toString());
+  if (innovation_gate) options.fusion.innovation_gate_chi2 = *innovation_gate;
+  if (auto s = options.validate(); !s.isOk()) {
+    std::fprintf(stderr, "%s: %s\n", kProgram, s.toString().c_str());
+    return sunvo::cli::kExitUsage;
+  }
   const auto sources = sunvo::experiment::defaultSunSources(static_cast<std::uint32_t>(seed));
 
   std::string summary =
       "| route | source | final drift [m] | change | rot. ARMSE [1e-3] | change | "
       "sun accepted / offered |\n|---|---|---|---|---|---|---|\n";
-  for (const std::string& id : splitComma(routes_arg)) {
-    sunvo::Expected<Route> route = [&]() -> sunvo::Expected<Route> {
-      if (id == "0020") return sunvo::experiment::loadRealTrackRoute0020(data_dir);
-      sunvo::experiment::SimulatedRouteOptions sim;
-      sim.seed = static_cast<std::uint32_t>(seed) + 6;
-      return sunvo::experiment::loadSimulatedKittiRoute(data_dir, id, sim);
-    }();
-    if (!route) {
-      std::fprintf(stderr, "sunvo_experiment: route %s: %s\n", id.c_str(),
-                   route.status().toString().c_str());
-      return 2;
-    }
+  for (const std::string& route_spec : splitComma(routes_arg)) {
+    const std::string id = routeId(route_spec);
+    sunvo::experiment::SimulatedRouteOptions sim;
+    sim.seed = static_cast<std::uint32_t>(seed) + 6;
+    sunvo::Expected<Route> route = sunvo::experiment::loadRoute(route_spec, data_dir, sim);
+    if (!route)
+      return sunvo::cli::fail(kProgram, "route " + route_spec + ": " + route.status().toString());
     std::fprintf(stderr, "route %s: %zu frames\n", route->name.c_str(), route->frames.size());
     std::vector<RunResult> runs;
     for (std::size_t s = 0; s <= sources.size(); ++s) {
       std::optional<sunvo::experiment::SunSourceSpec> spec;
       if (s > 0) spec = sources[s - 1];
       auto run = sunvo::experiment::runRoute(*route, spec, options);
-      if (!run) {
-        std::fprintf(stderr, "sunvo_experiment: %s: %s\n", route->name.c_str(),
-                     run.status().toString().c_str());
-        return 1;
-      }
+      if (!run) return sunvo::cli::fail(kProgram, route->name + ": " + run.status().toString());
       std::fprintf(stderr, "  %-28s done (%.2f ms/frame median, %d lost)\n", run->name.c_str(),
                    run->median_ms, run->lost_frames);
       runs.push_back(std::move(*run));
@@ -197,18 +165,19 @@ int main(int argc, char** argv) {
       const auto write = [&](const std::string& name, const std::vector<sunvo::Isometry3>& T) {
         sunvo::files::Trajectory t;
         t.T_w_c = T;
-        t.t_ns.resize(T.size());
-        return sunvo::files::writeKittiPoses(out_dir + "/route_" + id + "_" + name + ".txt", t);
+        t.t_ns.assign(route->times_ns.begin(),
+                      route->times_ns.begin() + static_cast<std::ptrdiff_t>(T.size()));
+        return sunvo::files::writeTrajectoryFiles(out_dir + "/route_" + id + "_" + name, t);
       };
-      if (auto s = write("gt", gt); !s.isOk()) return usage(s.toString());
+      if (auto s = write("gt", gt); !s.isOk()) return sunvo::cli::fail(kProgram, s);
       for (std::size_t i = 0; i < runs.size(); ++i) {
         if (auto s = write("run" + std::to_string(i), runs[i].T_w_c); !s.isOk()) {
-          return usage(s.toString());
+          return sunvo::cli::fail(kProgram, s);
         }
       }
     }
     auto table = sunvo::report::writeRouteReport(out_dir + "/route_" + id, input, gt, series);
-    if (!table) return usage(table.status().toString());
+    if (!table) return sunvo::cli::fail(kProgram, table.status());
     std::printf("\n### %s (%zu frames, %.0f m)\n\n%s", route->name.c_str(), input.num_poses,
                 runs.front().evaluation.table1.gt_path_length_m, table->c_str());
     const auto& base = runs.front().evaluation.table1;
@@ -226,7 +195,7 @@ int main(int argc, char** argv) {
   }
   std::printf("\n### Summary (change against pure VO on the same tracks)\n\n%s", summary.c_str());
   if (auto s = sunvo::files::writeWholeFile(out_dir + "/summary.md", summary); !s.isOk()) {
-    return usage(s.toString());
+    return sunvo::cli::fail(kProgram, s);
   }
   std::printf(
       "\nwrote %s/{route_*_table1.md, route_*_metrics.json, route_*_topview.png, summary.md}\n",

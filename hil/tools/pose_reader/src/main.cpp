@@ -35,11 +35,11 @@
 #include <vector>
 
 #include "sunvo/core/geometry.hpp"
+#include "sunvo/dataset/dataset.hpp"
 #include "sunvo/files/text_file.hpp"
 #include "sunvo/mavlink/conventions.hpp"
 #include "sunvo/mavlink/mavlink.hpp"
 #include "sunvo/metrics/metrics.hpp"
-#include "sunvo/replay/replay.hpp"
 
 namespace {
 
@@ -140,17 +140,17 @@ int main(int argc, char** argv) {
     usage();
     return 2;
   }
-  sunvo::replay::ReplayOptions ro;
-  ro.drive_dir = opt.drive;
-  ro.utc_offset_s = opt.utc_offset_s;
-  auto truth = sunvo::replay::loadReplayData(ro);
+  sunvo::dataset::DatasetOptions dopt;
+  dopt.path = opt.drive;
+  dopt.utc_offset_s = opt.utc_offset_s;
+  auto truth = sunvo::dataset::Dataset::open(dopt);
   if (!truth) {
     std::fprintf(stderr, "sunvo_pose_reader: %s\n", truth.status().message().c_str());
     return 2;
   }
   // A looped replay (more frames than the drive) is evaluated on its first pass, whose frame
   // times are the drive's; later passes carry later times.
-  const int truth_frames = std::min(opt.frames, static_cast<int>(truth->times_ns.size()));
+  const int truth_frames = std::min(opt.frames, static_cast<int>(truth->size()));
 
   // The pseudo-terminal: the program writes the slave, we read the master. We keep a slave fd
   // open too, so the master does not see a hang-up before the program opens its end.
@@ -198,10 +198,10 @@ int main(int argc, char** argv) {
   std::uint64_t heartbeats = 0, duplicates = 0, unknown_times = 0;
   std::map<std::uint64_t, int> times_seen;     // time_usec -> count
   std::map<std::uint64_t, int> index_of_time;  // time_usec -> frame index
-  for (std::size_t k = 0; k < truth->times_ns.size(); ++k) {
-    index_of_time[static_cast<std::uint64_t>(truth->times_ns[k] / 1000)] = static_cast<int>(k);
+  for (std::size_t k = 0; k < truth->size(); ++k) {
+    index_of_time[static_cast<std::uint64_t>(truth->timesNs()[k] / 1000)] = static_cast<int>(k);
   }
-  std::vector<int> seen(truth->times_ns.size(), 0);
+  std::vector<int> seen(truth->size(), 0);
   const TimeNs start = monoNs();
   const auto timeout_ns = static_cast<TimeNs>(opt.timeout_s * 1e9);
   bool term_sent = false, child_exited = false;
@@ -275,8 +275,8 @@ int main(int argc, char** argv) {
   std::vector<sunvo::Isometry3> est, gt;
   std::map<std::uint64_t, TimeNs> recv_of_time;  // time_usec -> arrival
   for (const Received& r : poses) recv_of_time[r.odo.time_usec] = r.recv_mono_ns;
-  std::vector<sunvo::Isometry3> by_frame(truth->times_ns.size());
-  std::vector<bool> have(truth->times_ns.size(), false);
+  std::vector<sunvo::Isometry3> by_frame(truth->size());
+  std::vector<bool> have(truth->size(), false);
   for (const Received& r : poses) {
     auto it = index_of_time.find(r.odo.time_usec);
     if (it == index_of_time.end()) continue;
@@ -287,7 +287,7 @@ int main(int argc, char** argv) {
   for (int k = 0; k < truth_frames; ++k) {
     if (!have[static_cast<std::size_t>(k)]) continue;  // counted in `missing`
     est.push_back(by_frame[static_cast<std::size_t>(k)]);
-    gt.push_back(truth->T_w_c_gt[static_cast<std::size_t>(k)]);
+    gt.push_back(truth->groundTruth()[static_cast<std::size_t>(k)]);
   }
   sunvo::metrics::Table1Metrics t1;
   bool evaluated = false;

@@ -1,7 +1,6 @@
-// sunvo_sun_eval: measures the image sun estimators against the true sun on image sets.
-//
-//   sunvo_sun_eval --images DIR [--images DIR ...] --out DIR [--estimators a,b,...]
-//                  [--frames N] [--prior-error-deg D] [--seed S] [--debug N] [--threads N]
+// sunvo_sun_eval: measures the image sun estimators against the true sun on image sets (any
+// dataset with images and a true sun: a sunvo render, a KITTI raw drive with its UTC offset, a
+// KITTI odometry folder with a sun file). --help lists the options.
 //
 // For every estimator and image set: azimuth error (camera-frame azimuth atan2(x, z), estimate
 // minus truth, wrapped) and zenith error (angle from the true "up", estimate minus truth) over the
@@ -13,7 +12,7 @@
 // prior-error-deg), deterministic for the seed. Writes sun_eval.md, sun_eval.json,
 // hist/<estimator>_<set>_{azimuth,zenith}.png, frames/<estimator>_<set>.csv and, for the first N
 // frames of each set, debug/ Fig.-1-style panels of the Lalonde estimators. Exit codes: 0 done, 1
-// an estimator failed, 2 bad arguments, unreadable input or unwritable output.
+// an estimator or an input failed, 2 bad arguments.
 
 #include <Eigen/Geometry>
 #include <cmath>
@@ -31,10 +30,11 @@
 
 #include "datasets.hpp"
 #include "histogram.hpp"
+#include "sunvo/cli/cli.hpp"
 #include "sunvo/files/trajectory_io.hpp"
 #include "sunvo/metrics/metrics.hpp"
 #include "sunvo/report/json_writer.hpp"
-#include "sunvo/sun_estimators/sun_estimators.hpp"
+#include "sunvo/sunestimators/sun_estimators.hpp"
 #include "sunvo/sunfusion/sun_gate.hpp"
 #include "sunvo/sunvision/lalonde_debug.hpp"
 
@@ -43,80 +43,21 @@ namespace fs = std::filesystem;
 using sunvo::Expected;
 using sunvo::Status;
 constexpr double kDeg = std::numbers::pi / 180.0;
-constexpr int kExitOk = 0, kExitFailed = 1, kExitUsage = 2;
-
-constexpr const char* kUsage =
-    "usage: sunvo_sun_eval --images DIR [--images DIR ...] --out DIR [--estimators a,b,...]\n"
-    "                      [--frames N] [--prior-error-deg D] [--seed S] [--debug N] [--threads "
-    "N]\n"
-    "  --images DIR        a sunvo_render drive folder or a KITTI odometry folder (image_0/,\n"
-    "                      calib.txt; true sun in DIR/sun_cam.csv or DIR/../<prefix>_sun_cam.csv)\n"
-    "  --out DIR           output folder (created)\n"
-    "  --estimators LIST   comma-separated (default: all known)\n"
-    "  --frames N          first N frames of each set (default: all)\n"
-    "  --prior-error-deg D per-axis 1-sigma attitude error of the VO prior, deg (default 5)\n"
-    "  --seed S            seed of that error (default 1)\n"
-    "  --debug N           debug panels for the first N frames of each set (default 2)\n"
-    "  --threads N         OpenCV threads (default 1: time per call on one core)\n";
+constexpr int kExitOk = 0, kExitFailed = 1;
+constexpr const char* kProgram = "sunvo_sun_eval";
 
 struct Args {
   std::vector<std::string> images;
   std::string out;
   std::vector<std::string> estimators;
+  std::string model = SUNVO_DEFAULT_SUN_CNN_MODEL;
+  std::optional<std::int64_t> utc_offset_s;
   int frames = 0;
   double prior_error_deg = 5.0;
   unsigned long long seed = 1;
   int debug = 2;
   int threads = 1;
 };
-
-bool parseNumber(const std::string& s, double* v) {
-  try {
-    std::size_t pos = 0;
-    *v = std::stod(s, &pos);
-    return pos == s.size() && std::isfinite(*v);
-  } catch (...) {
-    return false;
-  }
-}
-
-Expected<Args> parseArgs(int argc, char** argv) {
-  Args a;
-  for (int i = 1; i < argc; ++i) {
-    const std::string k = argv[i];
-    if (k == "--help" || k == "-h") return sunvo::invalidArgument("help");
-    if (i + 1 >= argc) return sunvo::invalidArgument(k + " needs a value");
-    const std::string v = argv[++i];
-    double x = 0.0;
-    if (k == "--images") {
-      a.images.push_back(v);
-    } else if (k == "--out") {
-      a.out = v;
-    } else if (k == "--estimators") {
-      std::stringstream ss(v);
-      std::string item;
-      while (std::getline(ss, item, ',')) {
-        if (!item.empty()) a.estimators.push_back(item);
-      }
-    } else if (k == "--frames" && parseNumber(v, &x) && x >= 0 && x == std::floor(x)) {
-      a.frames = static_cast<int>(x);
-    } else if (k == "--prior-error-deg" && parseNumber(v, &x) && x >= 0 && x <= 90) {
-      a.prior_error_deg = x;
-    } else if (k == "--seed" && parseNumber(v, &x) && x >= 0 && x == std::floor(x)) {
-      a.seed = static_cast<unsigned long long>(x);
-    } else if (k == "--debug" && parseNumber(v, &x) && x >= 0 && x == std::floor(x)) {
-      a.debug = static_cast<int>(x);
-    } else if (k == "--threads" && parseNumber(v, &x) && x >= 1 && x <= 64 && x == std::floor(x)) {
-      a.threads = static_cast<int>(x);
-    } else {
-      return sunvo::invalidArgument("bad option or value: " + k + " " + v);
-    }
-  }
-  if (a.images.empty()) return sunvo::invalidArgument("--images is required");
-  if (a.out.empty()) return sunvo::invalidArgument("--out is required");
-  if (a.estimators.empty()) a.estimators = sunvo::suneval::knownSunEstimators();
-  return a;
-}
 
 struct Stats {
   std::string estimator, dataset;
@@ -242,27 +183,19 @@ std::string json(const std::vector<Stats>& all, const Args& args) {
 
 int run(const Args& args) {
   cv::setNumThreads(args.threads);
-  auto estimators = sunvo::suneval::makeSunEstimators(args.estimators);
-  if (!estimators) {
-    std::fprintf(stderr, "sunvo_sun_eval: %s\n", estimators.status().toString().c_str());
-    return kExitUsage;
-  }
+  auto estimators = sunvo::sunestimators::makeSunEstimators(args.estimators, args.model);
+  if (!estimators) return sunvo::cli::fail(kProgram, estimators.status());
   std::vector<sunvo::suneval::EvalDataset> sets;
   for (const std::string& dir : args.images) {
-    Expected<sunvo::suneval::EvalDataset> ds = sunvo::suneval::loadEvalDataset(dir, args.frames);
-    if (!ds) {
-      std::fprintf(stderr, "sunvo_sun_eval: %s\n", ds.status().toString().c_str());
-      return kExitUsage;
-    }
+    Expected<sunvo::suneval::EvalDataset> ds =
+        sunvo::suneval::loadEvalDataset(dir, args.frames, args.utc_offset_s);
+    if (!ds) return sunvo::cli::fail(kProgram, ds.status());
     sets.push_back(std::move(*ds));
   }
   const fs::path out(args.out);
   std::error_code ec;
   for (const char* sub : {"hist", "frames", "debug"}) fs::create_directories(out / sub, ec);
-  if (ec) {
-    std::fprintf(stderr, "sunvo_sun_eval: %s: %s\n", args.out.c_str(), ec.message().c_str());
-    return kExitUsage;
-  }
+  if (ec) return sunvo::cli::fail(kProgram, args.out + ": " + ec.message());
 
   const sunvo::sunfusion::SunGateOptions gate;
   std::vector<Stats> all;
@@ -280,9 +213,7 @@ int run(const Args& args) {
       const sunvo::suneval::EvalFrame& f = ds.frames[k];
       const cv::Mat image = cv::imread(f.image_path, cv::IMREAD_UNCHANGED);
       if (image.empty() || (image.type() != CV_8UC3 && image.type() != CV_8UC1)) {
-        std::fprintf(stderr, "sunvo_sun_eval: %s: cannot read as 8-bit gray/BGR\n",
-                     f.image_path.c_str());
-        return kExitUsage;
+        return sunvo::cli::fail(kProgram, f.image_path + ": cannot read as 8-bit gray/BGR");
       }
       const Eigen::Matrix3d C_err = priorError(args.seed, ds.name, k, args.prior_error_deg);
       sunvo::sunfusion::ImageSunInput in;
@@ -344,10 +275,7 @@ int run(const Args& args) {
                 out / "debug" /
                     (std::string(est.name()) + "_" + ds.name + "_" + std::to_string(k) + ".png"),
                 dbg->panel);
-            if (!st) {
-              std::fprintf(stderr, "sunvo_sun_eval: %s\n", st.toString().c_str());
-              return kExitUsage;
-            }
+            if (!st) return sunvo::cli::fail(kProgram, st);
           }
         }
       }
@@ -366,33 +294,47 @@ int run(const Args& args) {
                       sunvo::suneval::drawErrorHistogram(per[ei].zen_err_deg, -90.0, 90.0, 5.0,
                                                          stem + " zenith"));
       }
-      if (!st) {
-        std::fprintf(stderr, "sunvo_sun_eval: %s\n", st.toString().c_str());
-        return kExitUsage;
-      }
+      if (!st) return sunvo::cli::fail(kProgram, st);
       all.push_back(std::move(per[ei]));
     }
   }
   const std::string md = markdown(all, args);
   Status st = sunvo::files::writeWholeFile((out / "sun_eval.md").string(), md);
   if (st) st = sunvo::files::writeWholeFile((out / "sun_eval.json").string(), json(all, args));
-  if (!st) {
-    std::fprintf(stderr, "sunvo_sun_eval: %s\n", st.toString().c_str());
-    return kExitUsage;
-  }
+  if (!st) return sunvo::cli::fail(kProgram, st);
   std::fputs(md.c_str(), stdout);
   return kExitOk;
 }
 }  // namespace
 
 int main(int argc, char** argv) {
-  const Expected<Args> args = parseArgs(argc, argv);
-  if (!args) {
-    if (args.status().message() != "help") {
-      std::fprintf(stderr, "sunvo_sun_eval: %s\n", args.status().message().c_str());
-    }
-    std::fputs(kUsage, stderr);
-    return kExitUsage;
-  }
-  return run(*args);
+  Args args;
+  CLI::App app{"Measures the image sun estimators against the true sun on image sets.", kProgram};
+  app.add_option("--images", args.images,
+                 "an image set: a sunvo render, a KITTI raw drive (with --utc-offset-s) or a KITTI "
+                 "odometry folder (true sun in DIR/sun_cam.csv or DIR/../<NN>_sun_cam.csv); repeat "
+                 "for several")
+      ->required()
+      ->check(CLI::ExistingPath);
+  app.add_option("--out", args.out, "output folder (created)")->required();
+  app.add_option("--estimators", args.estimators, "comma-separated (default: all known)")
+      ->delimiter(',')
+      ->check(CLI::IsMember(sunvo::sunestimators::knownSunEstimators()));
+  app.add_option("--model", args.model, "the Sun-CNN ONNX model");
+  app.add_option("--utc-offset-s", args.utc_offset_s,
+                 "offset of a KITTI raw drive's timestamps to UTC, s (a render writes UTC)")
+      ->check(CLI::Range(-50400, 50400));
+  app.add_option("--frames", args.frames, "first N frames of each set (0 = all)")
+      ->check(CLI::Range(0, 10000000));
+  app.add_option("--prior-error-deg", args.prior_error_deg,
+                 "per-axis 1-sigma attitude error of the VO prior, deg")
+      ->check(CLI::Range(0.0, 90.0));
+  app.add_option("--seed", args.seed, "seed of that error");
+  app.add_option("--debug", args.debug, "debug panels for the first N frames of each set")
+      ->check(CLI::Range(0, 1000000));
+  app.add_option("--threads", args.threads, "OpenCV threads (1: time per call on one core)")
+      ->check(CLI::Range(1, 64));
+  if (auto code = sunvo::cli::parse(app, argc, argv)) return *code;
+  if (args.estimators.empty()) args.estimators = sunvo::sunestimators::knownSunEstimators();
+  return run(args);
 }

@@ -66,6 +66,9 @@ std::string formatKittiPoses(const Trajectory& trajectory);
 Expected<std::string> formatTumTrajectory(const Trajectory& trajectory);
 Status writeKittiPoses(const std::string& path, const Trajectory& trajectory);
 Status writeTumTrajectory(const std::string& path, const Trajectory& trajectory);
+// Both at once, for evaluation tools such as evo: <base>.txt (KITTI) and <base>_tum.txt (TUM, with
+// the trajectory's times). Every sunvo program that writes poses writes this pair.
+Status writeTrajectoryFiles(const std::string& base, const Trajectory& trajectory);
 
 // Parses a number of seconds ("12.5", "1317384588.915486", "1.037359e-01") into ns. Plain
 // decimal text is converted exactly (digits beyond the 9th decimal are rounded); text with an

@@ -6,7 +6,8 @@
 // the true sun direction in each camera frame. The world frame is the first camera frame (KITTI
 // odometry ground truth has no GPS); the sun in that world at frame k is s_w,k = C_w_ck,gt s_ck,gt,
 // which is what an ephemeris gives at the frame's time and place once the first pose is known
-// (and it keeps the sun's slow motion, about 0.25 deg/min, that the paper ignored).
+// (and it keeps the sun's slow motion, about 0.25 deg/min, that the paper ignored). Each run is one
+// pipeline::SunAidedOdometry over the tracks.
 //
 // Sun measurements are made every `every_n_frames` frames from the truth through a sun source:
 // the true vector itself ("ground truth"), or an error model emulating an image estimator.
@@ -30,8 +31,11 @@ struct Route {
   std::string name;  // e.g. "2011_09_30_drive_0020 (real tracks)"
   StereoCamera camera;
   std::vector<FrameFeatures> frames;
-  std::vector<Isometry3> T_w_c_gt;        // world = first camera frame
+  std::vector<TimeNs> times_ns;           // frame times (UTC ns when known, else relative)
+  std::vector<Isometry3> T_w_c_gt;        // world = first camera frame of the recording
   std::vector<Eigen::Vector3d> sun_c_gt;  // true unit sun vector per frame, camera frame
+  std::vector<Eigen::Vector3d> sun_w;     // the same in the world frame
+  Eigen::Vector3d world_up = -Eigen::Vector3d::UnitY();  // KITTI's first camera is level
 };
 
 struct SunSourceSpec {
@@ -73,16 +77,21 @@ Expected<RunResult> runRoute(const Route& route, const std::optional<SunSourceSp
 // assumptions, documented in docs/experiment.md, not numbers from the paper.
 std::vector<SunSourceSpec> defaultSunSources(std::uint32_t seed);
 
-// Routes from the real data folder (SUNVO_DATA_DIR layout, see shared/data/README.md).
-Expected<Route> loadRealTrackRoute0020(const std::string& data_dir);
 struct SimulatedRouteOptions {
   std::uint32_t seed = 7;
   double pixel_noise_px = 0.7;  // tracks' pixel noise, px
   double outlier_share = 0.05;  // gross mismatches
 };
-// seq "00" or "06": simulated tracks along the real KITTI odometry ground truth, with the real
-// calibration of that drive and the real ground-truth sun.
-Expected<Route> loadSimulatedKittiRoute(const std::string& data_dir, const std::string& seq,
-                                        const SimulatedRouteOptions& options);
+
+// A route by name or path, through the dataset seam (drivers/dataset):
+//  - "0020": the real feature tracks of 2011_09_30_drive_0020 (DATA/kitti_tracks) with the true sun
+//    of KITTI odometry sequence 06 (the same drive);
+//  - "NN" (a KITTI odometry sequence id): DATA/kitti_odometry/NN, i.e. NN_gt_poses.txt,
+//    NN_times.txt and NN_sun_cam.csv, with tracks simulated along the ground truth;
+//  - any other string: a dataset path (a track folder with a sun file, or a trajectory folder or
+//    prefix): its real tracks when it has them, else tracks simulated along its ground truth.
+// The route needs ground truth and the true sun for every frame.
+Expected<Route> loadRoute(const std::string& spec, const std::string& data_dir,
+                          const SimulatedRouteOptions& options);
 
 }  // namespace sunvo::experiment

@@ -1,31 +1,32 @@
 #pragma once
-// Replay of a recorded (or rendered) drive in the KITTI raw layout through the whole estimation
-// chain, as it runs on the rover:
-//   KittiStereoSource (images, UTC timestamps) -> OXTS of the first frame -> local ENU world
-//   (GeographicLib) and the first camera pose through the calibration chain -> per frame:
-//   image pipeline (front end + RANSAC + window) with the sun residual every n-th frame, the sun
-//   in the world from the NREL SPA at the frame's GPS fix and UTC time.
-// Sun measurements come from a sun source: here the drive's ground-truth sun in the camera
-// (gt/sun_cam0.csv, written by the renderer) through an error model, until the image estimators
-// land. Ground truth for the evaluation: gt/poses_cam0_enu.txt (camera 0 in the same ENU frame).
+// Replay of a recorded (or rendered) drive with images through the whole estimation chain, as it
+// runs on the rover:
+//   dataset (drivers/dataset: a KITTI raw drive, a sunvo render or a KITTI odometry sequence) ->
+//   images through kitti::KittiStereoSource -> pipeline::SunAidedOdometry (front end + RANSAC +
+//   window, the sun residual every n-th frame) from the dataset's first camera pose.
+// The sun in the world comes from the NREL SPA at the frame's GPS fix and UTC time when the
+// dataset has fixes and a known UTC (raw drives, renders), else from the dataset's true sun.
+// Measurements come from a sun source: the dataset's true sun in the camera through an error model
+// (experiment::SunSourceSpec), or an image estimator run on the left image every n-th frame with
+// the prior from the last VO pose. Ground truth for the evaluation: the dataset's.
 // Deterministic: the solver is bounded by iterations only.
 
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "sunvo/dataset/dataset.hpp"
 #include "sunvo/experiment/experiment.hpp"
-#include "sunvo/geodesy/local_enu.hpp"
-#include "sunvo/pipeline/stereo_visual_odometry.hpp"
+#include "sunvo/pipeline/sun_aided_odometry.hpp"
 #include "sunvo/sunfusion/image_sun_estimator.hpp"
 
 namespace sunvo::replay {
 
 struct ReplayOptions {
-  std::string drive_dir;          // <date>/<date>_drive_NNNN_sync, with oxts/ and gt/
-  std::int64_t utc_offset_s = 0;  // s: offset of the drive's timestamps to UTC (renderer: 0)
-  int every_n_frames = 5;         // a sun measurement every n-th frame, [1, 1000]
-  int max_frames = 0;             // 0 = all
+  // The drive: dataset.path and, for a KITTI raw drive, dataset.utc_offset_s (KITTI's files name
+  // no zone; a render writes UTC). dataset.last_frame limits the frames.
+  dataset::DatasetOptions dataset;
+  int every_n_frames = 5;  // a sun measurement every n-th frame, [1, 1000]
   pipeline::PipelineOptions pipeline;
   // The first camera pose comes from the first OXTS record (an RT3000-class INS: about 0.03 deg
   // roll/pitch and 0.1 deg heading), so the attitude prior sigma is 0.1 deg, not the generic 1.
@@ -48,7 +49,8 @@ struct ReplayOptions {
 
 struct ReplayRun {
   std::string name;
-  std::vector<Isometry3> T_w_c;  // ENU world
+  std::vector<Isometry3> T_w_c;  // the dataset's world
+  std::vector<TimeNs> times_ns;  // the frames' times
   sunfusion::GateCounters gate;
   int lost_frames = 0;
   double median_ms = 0.0;  // pipeline time per frame
@@ -57,20 +59,13 @@ struct ReplayRun {
   std::vector<double> sun_ms;  // their wall times, ms
 };
 
-struct ReplayData {
-  std::vector<Isometry3> T_w_c_gt;  // camera 0 in the replay's world (ENU at the first GPS fix)
-  std::vector<TimeNs> times_ns;
-  geodesy::GeodeticPoint origin;
-};
-
-// Loads the ground truth of a drive (gt/poses_cam0_enu.txt in the ENU frame of gt/origin.txt,
-// moved into the world of the replay; image_00/timestamps.txt; the first OXTS fix).
-Expected<ReplayData> loadReplayData(const ReplayOptions& options);
+// Opens the dataset of a replay; it must have images. An image estimator gets the colour images
+// when the drive has them, else the gray ones (if it accepts gray).
+Expected<dataset::Dataset> openReplayDataset(const ReplayOptions& options);
 
 // One run: pure VO (no spec, no estimator), VO + sun from one error-model source (spec), or
-// VO + sun from an image estimator run on the left colour image every n-th frame, with the prior
-// from the last VO pose and the ephemeris (image_sun; not both).
-Expected<ReplayRun> replayDrive(const ReplayOptions& options,
+// VO + sun from an image estimator (image_sun; not both).
+Expected<ReplayRun> replayDrive(const dataset::Dataset& data, const ReplayOptions& options,
                                 const std::optional<experiment::SunSourceSpec>& spec,
                                 sunfusion::ImageSunEstimator* image_sun = nullptr);
 

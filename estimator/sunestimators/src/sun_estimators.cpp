@@ -1,9 +1,9 @@
-#include "sunvo/sun_estimators/sun_estimators.hpp"
+#include "sunvo/sunestimators/sun_estimators.hpp"
 
 #include "sunvo/suncnn/sun_cnn_estimator.hpp"
 #include "sunvo/sunvision/lalonde_estimator.hpp"
 
-namespace sunvo::suneval {
+namespace sunvo::sunestimators {
 namespace {
 Expected<std::unique_ptr<sunfusion::ImageSunEstimator>> lalonde(sunvision::LalondePrior prior) {
   sunvision::LalondeOptions options;
@@ -13,10 +13,9 @@ Expected<std::unique_ptr<sunfusion::ImageSunEstimator>> lalonde(sunvision::Lalon
   return std::unique_ptr<sunfusion::ImageSunEstimator>(std::move(e));
 }
 
-// The shipped model (config/sun_cnn.onnx) with its default options.
-Expected<std::unique_ptr<sunfusion::ImageSunEstimator>> sunCnn() {
+Expected<std::unique_ptr<sunfusion::ImageSunEstimator>> sunCnn(const std::string& model_path) {
   auto e = std::make_unique<suncnn::SunCnnEstimator>();
-  SUNVO_RETURN_IF_ERROR(e->init(suncnn::SunCnnOptions{}, SUNVO_DEFAULT_SUN_CNN_MODEL));
+  SUNVO_RETURN_IF_ERROR(e->init(suncnn::SunCnnOptions{}, model_path));
   return std::unique_ptr<sunfusion::ImageSunEstimator>(std::move(e));
 }
 }  // namespace
@@ -25,22 +24,27 @@ std::vector<std::string> knownSunEstimators() {
   return {"lalonde", "lalonde_vo", "sun_cnn"};
 }
 
-Expected<std::unique_ptr<sunfusion::ImageSunEstimator>> makeSunEstimator(const std::string& name) {
+bool needsColour(const std::string& name) {
+  return name == "sun_cnn";
+}
+
+Expected<std::unique_ptr<sunfusion::ImageSunEstimator>> makeSunEstimator(
+    const std::string& name, const std::string& model_path) {
   if (name == "lalonde") return lalonde(sunvision::LalondePrior::kZenith);
   if (name == "lalonde_vo") return lalonde(sunvision::LalondePrior::kVisualOdometry);
-  if (name == "sun_cnn") return sunCnn();
-  return notFound("unknown sun estimator '" + name + "'");
+  if (name == "sun_cnn") return sunCnn(model_path);
+  return notFound("unknown sun estimator '" + name + "' (known: lalonde, lalonde_vo, sun_cnn)");
 }
 
 Expected<std::vector<std::unique_ptr<sunfusion::ImageSunEstimator>>> makeSunEstimators(
-    const std::vector<std::string>& names) {
+    const std::vector<std::string>& names, const std::string& model_path) {
   std::vector<std::unique_ptr<sunfusion::ImageSunEstimator>> out;
   for (const std::string& n : names) {
-    Expected<std::unique_ptr<sunfusion::ImageSunEstimator>> e = makeSunEstimator(n);
+    Expected<std::unique_ptr<sunfusion::ImageSunEstimator>> e = makeSunEstimator(n, model_path);
     if (!e) return e.status();
     out.push_back(std::move(*e));
   }
   return out;
 }
 
-}  // namespace sunvo::suneval
+}  // namespace sunvo::sunestimators

@@ -1,0 +1,97 @@
+#pragma once
+// The sun-aided estimator every program calls: stereo visual odometry whose world attitude is
+// corrected by absolute sun directions inside the bounded bundle window (the paper's Eq. 3).
+//
+//   SunAidedOdometry odo;
+//   SUNVO_RETURN_IF_ERROR(odo.init(options, camera, T_w_c0));       // images (front end + VO)
+//   for each frame k:
+//     if (odo.isSunFrame(k)) odo.addSun({measurement_in_camera_k, sun_w});   // when one exists
+//     Expected<FrameResult> r = odo.process(frame);                        // or FrameFeatures
+//
+// It owns the odometry (front end for images, or tracks in; RANSAC; the Ceres window), the sun
+// fusion (gate, residuals, the world-attitude estimate and its covariance), the every-n schedule
+// and the window's residual hooks: callers never reach into the window. A sun measurement is
+// offered for a frame about to be processed or still in the window; a later one is counted late.
+// sun_w, the sun in the VO world, comes from the caller (an ephemeris at the frame's time and
+// place, or a dataset's truth), so this class stays free of clocks and positions.
+//
+// No threads, files or devices; deterministic for the same inputs. Not thread-safe except
+// isSunFrame(), which reads the immutable schedule (the rover's capture thread asks it).
+
+#include <cstdint>
+
+#include "sunvo/core/camera.hpp"
+#include "sunvo/core/features.hpp"
+#include "sunvo/core/geometry.hpp"
+#include "sunvo/core/status.hpp"
+#include "sunvo/core/stereo_frame.hpp"
+#include "sunvo/pipeline/stereo_visual_odometry.hpp"
+#include "sunvo/sunfusion/sun_window_term.hpp"
+
+namespace sunvo::pipeline {
+
+struct SunAidedOptions {
+  PipelineOptions pipeline;            // front end (image input) and back end
+  bool use_sun = true;                 // false: pure VO (the schedule never asks for the sun)
+  int every_n_frames = 5;              // a sun measurement every n-th frame, [1, 1000]
+  sunfusion::SunFusionOptions fusion;  // gate, world "up", attitude model (sun_window_term.hpp)
+
+  // The error names the bad key ("sun_aided.every_n_frames", "pipeline.*", "sun_fusion.*").
+  Status validate() const;
+};
+
+enum class OdometryInput { kImages, kFeatures };
+
+class SunAidedOdometry {
+ public:
+  // Allocates every buffer. input kImages: process(StereoFrame) (front end + back end);
+  // kFeatures: process(FrameFeatures) (back end only; the front end is not allocated).
+  // T_w_c0: camera 0 of the first frame in the world. May be called again to restart.
+  Status init(const SunAidedOptions& options, const StereoCamera& camera, const Isometry3& T_w_c0,
+              OdometryInput input = OdometryInput::kImages);
+
+  // True for the frames of the every-n schedule when the sun is used (never frame 0: its pose
+  // is the given start, nothing to correct).
+  bool isSunFrame(std::uint64_t sequence) const {
+    return options_.use_sun && sequence > 0 &&
+           sequence % static_cast<std::uint64_t>(options_.every_n_frames) == 0;
+  }
+  // A measurement in camera k (observation.measurement.sequence = k) with the sun in the world.
+  // Ignored (counted in sunOffered() only) when the sun is off.
+  void addSun(const sunfusion::SunObservation& observation);
+
+  Expected<FrameResult> process(const StereoFrame& frame);     // kImages
+  Expected<vo::VoResult> process(const FrameFeatures& frame);  // kFeatures
+
+  // Camera 0 of the last processed frame in the world (T_w_c0 before the first).
+  const Isometry3& T_w_c() const { return T_w_c_; }
+  // Sun bookkeeping: what the gate decided, the world-attitude covariance (rad^2, world frame).
+  const sunfusion::GateCounters& sunCounters() const { return sun_term_.counters(); }
+  const Eigen::Matrix3d& attitudeCovariance() const { return sun_term_.attitudeCovariance(); }
+  const sunfusion::SunWindowTerm& sunTerm() const { return sun_term_; }
+  std::uint64_t sunOffered() const { return sun_offered_; }
+
+  // The rover shrinks the solver's time budget when a frame is late (seconds, > 0).
+  void setSolverTimeBudget(double seconds);
+  // A monotonically increasing event count sampled around the front end and the back end.
+  void setStageCounter(StereoVisualOdometry::StageCounter counter) { vo_.setStageCounter(counter); }
+  // The features of the last image frame (valid until the next call).
+  const FrameFeatures& lastFeatures() const { return vo_.lastFeatures(); }
+  const SunAidedOptions& options() const { return options_; }
+
+ private:
+  vo::StereoOdometry& backEnd() {
+    return input_ == OdometryInput::kImages ? vo_.odometry() : tracks_;
+  }
+
+  SunAidedOptions options_;
+  OdometryInput input_ = OdometryInput::kImages;
+  StereoVisualOdometry vo_;    // image input: front end + its own back end
+  vo::StereoOdometry tracks_;  // feature input: the back end alone
+  sunfusion::SunWindowTerm sun_term_;
+  Isometry3 T_w_c_ = Isometry3::Identity();
+  std::uint64_t sun_offered_ = 0;
+  bool initialized_ = false;
+};
+
+}  // namespace sunvo::pipeline
