@@ -5,6 +5,7 @@
 //   sunvo_rover --config config/rover.yaml [--set key=value ...]
 //
 // Exit codes: 0 clean shutdown, 2 bad command line or config, 1 any other start-up failure.
+// --help and --version answer and exit 0.
 
 #include <signal.h>
 
@@ -14,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include "sunvo/cli/cli.hpp"
 #include "sunvo/rover/app.hpp"
 #include "sunvo/rover/config.hpp"
 #include "sunvo/rover/mavlink_link.hpp"
@@ -39,43 +41,29 @@ long residentKb() {
   return kb;
 }
 
-void usage() {
-  std::fprintf(stderr,
-               "usage: sunvo_rover --config FILE [--set key=value]...\n"
-               "  --config FILE     YAML config (config/rover.yaml, config/rover_replay.yaml)\n"
-               "  --set key=value   override one config key, e.g. --set serial.device=/dev/pts/3\n"
-               "signals: SIGINT/SIGTERM stop cleanly, SIGUSR1 writes the latency profile\n");
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
   std::string config_path;
+  std::vector<std::string> sets;
+  CLI::App cli{
+      "The onboard sun-aided stereo VO program. Signals: SIGINT/SIGTERM stop cleanly, "
+      "SIGUSR1 writes the latency profile.",
+      "sunvo_rover"};
+  cli.add_option("--config", config_path,
+                 "YAML config (config/rover.yaml, config/rover_replay.yaml)")
+      ->required();
+  cli.add_option("--set", sets, "override one config key, e.g. --set serial.device=/dev/pts/3")
+      ->check([](const std::string& kv) {
+        const auto eq = kv.find('=');
+        return eq == std::string::npos || eq == 0 ? std::string("expected key=value")
+                                                  : std::string();
+      });
+  if (auto code = sunvo::cli::parse(cli, argc, argv)) return *code;
   std::vector<std::pair<std::string, std::string>> overrides;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--config" && i + 1 < argc) {
-      config_path = argv[++i];
-    } else if (a == "--set" && i + 1 < argc) {
-      const std::string kv = argv[++i];
-      const auto eq = kv.find('=');
-      if (eq == std::string::npos || eq == 0) {
-        std::fprintf(stderr, "sunvo_rover: --set %s: expected key=value\n", kv.c_str());
-        return 2;
-      }
-      overrides.emplace_back(kv.substr(0, eq), kv.substr(eq + 1));
-    } else if (a == "--help" || a == "-h") {
-      usage();
-      return 0;
-    } else {
-      std::fprintf(stderr, "sunvo_rover: unknown argument '%s'\n", a.c_str());
-      usage();
-      return 2;
-    }
-  }
-  if (config_path.empty()) {
-    usage();
-    return 2;
+  for (const std::string& kv : sets) {
+    const auto eq = kv.find('=');
+    overrides.emplace_back(kv.substr(0, eq), kv.substr(eq + 1));
   }
   auto config = sunvo::rover::loadRoverConfig(config_path, overrides);
   if (!config) {
@@ -128,7 +116,7 @@ int main(int argc, char** argv) {
 
   // RSS once the warm-up frames are through, and at the end: growth = a leak or a buffer that
   // grows.
-  const auto warmup = static_cast<std::uint64_t>(config->estimator.warmup_frames);
+  const auto warmup = static_cast<std::uint64_t>(config->realtime.warmup_frames);
   long rss_warm_kb = -1;
   std::uint64_t rss_warm_frame = 0;
   int dumps = 0;

@@ -11,7 +11,7 @@ TEST(FramePool, SlotsAreAllocatedOnceAndHandedOutUntilExhausted) {
   FramePoolOptions o;
   o.width = 64;
   o.height = 32;
-  o.depth = 3;
+  o.pool_depth = 3;
   auto pool = FramePool::create(o);
   ASSERT_TRUE(pool) << pool.status().toString();
   FramePool& p = **pool;
@@ -38,7 +38,7 @@ TEST(FramePool, SlotsAreAllocatedOnceAndHandedOutUntilExhausted) {
 
 TEST(FramePool, OptionsNameTheBadKey) {
   FramePoolOptions o;
-  o.depth = 1;
+  o.pool_depth = 1;
   EXPECT_NE(o.validate().message().find("frames.pool_depth"), std::string::npos);
   o = FramePoolOptions{};
   o.width = 8;

@@ -22,7 +22,7 @@ const char* kMinimal =
     "    drive_dir: /data/drive_sync\n"
     "estimator:\n"
     "  window:\n"
-    "    max_iterations: 12\n";
+    "    max_num_iterations: 12\n";
 
 TEST(RoverConfig, TheShippedConfigsLoad) {
   auto replay = loadRoverConfig(std::string(SUNVO_SOURCE_DIR) + "/config/rover_replay.yaml");
@@ -32,7 +32,7 @@ TEST(RoverConfig, TheShippedConfigsLoad) {
   EXPECT_EQ(replay->sun.provider, SunProviderType::kCsv);
   EXPECT_EQ(replay->source.kitti.end, EndAction::kHold);
   EXPECT_EQ(replay->frames.width, 1242);
-  EXPECT_EQ(replay->rt.capture.fifo_priority, 80);
+  EXPECT_EQ(replay->rt.threads.capture.fifo_priority, 80);
   // The deployment file: V4L2 pair with the GPIO strobe; Sun-CNN is refused there (the V4L2
   // source delivers gray and the CNN needs colour), naming the key; Lalonde takes gray.
   auto rover = loadRoverConfig(std::string(SUNVO_SOURCE_DIR) + "/config/rover.yaml");
@@ -56,26 +56,40 @@ TEST(RoverConfig, TheShippedConfigsLoad) {
 
 TEST(RoverConfig, DefaultsAndOverrides) {
   const std::string path = writeConfig("minimal.yaml", kMinimal);
-  auto c = loadRoverConfig(path, {{"estimator.deadline_ms", "80"},
+  auto c = loadRoverConfig(path, {{"realtime.deadline_ms", "80"},
                                   {"serial.device", "/dev/pts/9"},
                                   {"sun.provider", "csv"},
-                                  {"sun.csv", "/data/sun.csv"}});
+                                  {"sun.csv", "/data/sun.csv"},
+                                  {"estimator.fusion.gate.plane", "xz"},
+                                  {"estimator.frontend.max_features", "1500"}});
   ASSERT_TRUE(c) << c.status().toString();
-  EXPECT_EQ(c->estimator.max_iterations, 12);
-  EXPECT_EQ(c->estimator.deadline_ms, 80.0);
-  EXPECT_EQ(c->estimator.window_size, 2);  // default
+  // The estimator section is the estimator's own options struct: its field names are the keys.
+  EXPECT_EQ(c->estimator.pipeline.vo.window.max_num_iterations, 12);
+  EXPECT_EQ(c->estimator.pipeline.vo.window.window_size, 2);  // default
+  EXPECT_EQ(c->estimator.pipeline.frontend.max_features, 1500);
+  EXPECT_EQ(c->estimator.fusion.gate.plane, sunfusion::GatePlane::kXZ);
+  // The rover's defaults of the estimator: a 40 ms solver budget, the image estimators' cap.
+  EXPECT_DOUBLE_EQ(c->estimator.pipeline.vo.window.max_solver_time_in_seconds, 0.040);
+  EXPECT_DOUBLE_EQ(c->estimator.fusion.max_drift_deg_per_frame, 0.01);
+  EXPECT_EQ(c->realtime.deadline_ms, 80.0);
   EXPECT_EQ(c->serial.device, "/dev/pts/9");
   EXPECT_EQ(c->sun.csv, "/data/sun.csv");
   EXPECT_EQ(c->queues.frames, 4);
-  EXPECT_FALSE(c->describe().empty());
+  // Every key is printed once, by the same list that reads it.
+  const std::string text = c->describe();
+  EXPECT_NE(text.find("  estimator.window.max_num_iterations: 12\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("  estimator.fusion.gate.plane: xz\n"), std::string::npos);
+  EXPECT_NE(text.find("  rt.threads.capture.fifo_priority: 80\n"), std::string::npos);
+  EXPECT_NE(text.find("  source.kitti.end: stop\n"), std::string::npos);
 }
 
 TEST(RoverConfig, ErrorsNameTheFileTheKeyAndTheLine) {
   const std::string path = writeConfig("minimal.yaml", kMinimal);
-  auto range = loadRoverConfig(path, {{"estimator.window.max_iterations", "0"}});
+  auto range = loadRoverConfig(path, {{"estimator.window.max_num_iterations", "0"}});
   ASSERT_FALSE(range);
-  EXPECT_EQ(range.status().message(),
-            path + ": estimator.window.max_iterations: 0 is outside [1, 100]");
+  EXPECT_NE(range.status().message().find(path + ": estimator: window.max_num_iterations"),
+            std::string::npos)
+      << range.status().message();
 
   const std::string unknown = writeConfig("unknown.yaml", std::string(kMinimal) + "  bogus: 3\n");
   auto u = loadRoverConfig(unknown);
@@ -87,10 +101,10 @@ TEST(RoverConfig, ErrorsNameTheFileTheKeyAndTheLine) {
   EXPECT_NE(top.status().message().find("telemetri: unknown key"), std::string::npos);
 
   const std::string typed =
-      writeConfig("typed.yaml", std::string(kMinimal) + "  deadline_ms: fast\n");
+      writeConfig("typed.yaml", std::string(kMinimal) + "  every_n_frames: often\n");
   auto t = loadRoverConfig(typed);
   ASSERT_FALSE(t);
-  EXPECT_EQ(t.status().message(), typed + ":7: estimator.deadline_ms: expected a number");
+  EXPECT_EQ(t.status().message(), typed + ":7: estimator.every_n_frames: expected an integer");
 
   auto e = loadRoverConfig(path, {{"source.kitti.end", "rewind"}});
   ASSERT_FALSE(e);
@@ -98,10 +112,24 @@ TEST(RoverConfig, ErrorsNameTheFileTheKeyAndTheLine) {
                                       "pingpong"),
             std::string::npos);
 
-  auto drift = loadRoverConfig(path, {{"sun.max_drift_deg_per_frame", "0"}});
+  auto drift = loadRoverConfig(path, {{"estimator.fusion.max_drift_deg_per_frame", "0"}});
   ASSERT_FALSE(drift);
-  EXPECT_EQ(drift.status().message(),
-            path + ": sun.max_drift_deg_per_frame: 0 is outside [0.002, 5]");
+  EXPECT_NE(drift.status().message().find(path + ": estimator: "), std::string::npos)
+      << drift.status().message();
+  EXPECT_NE(drift.status().message().find("max_drift_deg_per_frame"), std::string::npos);
+
+  auto plane = loadRoverConfig(path, {{"estimator.fusion.gate.plane", "diagonal"}});
+  ASSERT_FALSE(plane);
+  EXPECT_NE(plane.status().message().find(
+                "estimator.fusion.gate.plane: 'diagonal' is not one of full_3d, xz"),
+            std::string::npos)
+      << plane.status().message();
+
+  auto budget = loadRoverConfig(path, {{"realtime.min_solver_time_ms", "50"}});
+  ASSERT_FALSE(budget);
+  EXPECT_NE(budget.status().message().find("realtime.min_solver_time_ms: 50 is outside [0.1, 40]"),
+            std::string::npos)
+      << budget.status().message();
 
   auto q = loadRoverConfig(path, {{"queues.frames", "3"}});
   ASSERT_FALSE(q);

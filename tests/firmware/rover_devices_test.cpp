@@ -108,7 +108,7 @@ RunResult runRig(int exposures, int drop_at, const std::string& sun_provider = "
         "{capture: {fifo_priority: 0, cpu: -1}, estimator: {fifo_priority: 0, "
         "cpu: -1}, sun: {fifo_priority: 0, cpu: -1}, telemetry: {fifo_priority: "
         "0, cpu: -1}}"},
-       {"estimator.warmup_frames", "0"},
+       {"realtime.warmup_frames", "0"},
        {"sun.provider", sun_provider},
        {"profiling.output_dir", out}});
   EXPECT_TRUE(config.hasValue()) << config.status().toString();

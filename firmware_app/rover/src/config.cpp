@@ -140,144 +140,67 @@ class Reader {
   std::set<std::string> sections_;  // map keys walked
 };
 
-template <typename E>
-Status readEnum(Reader& r, const YAML::Node& map, const std::string& prefix, const char* key,
-                const std::vector<std::string>& names, E* out) {
-  int v = static_cast<int>(*out);
-  SUNVO_RETURN_IF_ERROR(r.getEnum(map, prefix, key, names, &v));
-  *out = static_cast<E>(v);
-  return Status::ok();
-}
+// Reads every field of an options struct from its YAML map (core/fields.hpp): sections recurse,
+// enums by name, scalars by type; the first error stops the walk.
+class ReadVisitor {
+ public:
+  ReadVisitor(Reader& r, YAML::Node map, std::string prefix)
+      : r_(r), map_(std::move(map)), prefix_(std::move(prefix)) {}
 
-const std::vector<std::string> kSourceNames = {"kitti", "v4l2"};
-const std::vector<std::string> kTriggerNames = {"simulated", "gpio"};
-const std::vector<std::string> kLayoutNames = {"two_devices", "side_by_side"};
-const std::vector<std::string> kPixelFormatNames = {"grey", "yuyv"};
-const std::vector<std::string> kEndNames = {"stop", "hold", "loop", "pingpong"};
-const std::vector<std::string> kWorldNames = {"oxts", "config"};
-const std::vector<std::string> kSunNames = {"none", "csv", "lalonde", "lalonde_vo", "sun_cnn"};
+  template <typename T>
+  void operator()(const char* key, T& value) {
+    if (!status_.isOk()) return;
+    if constexpr (OptionsStruct<T>) {
+      YAML::Node node;
+      status_ = r_.section(map_, prefix_, key, &node);
+      if (!status_.isOk()) return;
+      ReadVisitor sub(r_, node, prefix_.empty() ? key : prefix_ + "." + key);
+      T::fields(value, sub);
+      status_ = sub.status();
+    } else if constexpr (NamedEnum<T>) {
+      std::vector<std::string> names;
+      for (const std::string_view n : enumNames(value)) names.emplace_back(n);
+      int v = static_cast<int>(value);
+      status_ = r_.getEnum(map_, prefix_, key, names, &v);
+      value = static_cast<T>(v);
+    } else {
+      status_ = r_.get(map_, prefix_, key, &value);
+    }
+  }
+  const Status& status() const { return status_; }
 
-Status readThread(Reader& r, const YAML::Node& threads, const char* name,
-                  runtime::ThreadPolicy* p) {
-  YAML::Node n;
-  SUNVO_RETURN_IF_ERROR(r.section(threads, "rt.threads", name, &n));
-  const std::string prefix = std::string("rt.threads.") + name;
-  SUNVO_RETURN_IF_ERROR(r.get(n, prefix, "fifo_priority", &p->fifo_priority));
-  return r.get(n, prefix, "cpu", &p->cpu);
-}
+ private:
+  Reader& r_;
+  YAML::Node map_;
+  std::string prefix_;
+  Status status_;
+};
 
-Status readAll(Reader& r, const YAML::Node& root, RoverConfig* c) {
-  YAML::Node n, m;
-  // source
-  SUNVO_RETURN_IF_ERROR(r.section(root, "", "source", &n));
-  SUNVO_RETURN_IF_ERROR(readEnum(r, n, "source", "type", kSourceNames, &c->source.type));
-  SUNVO_RETURN_IF_ERROR(r.section(n, "source", "kitti", &m));
-  KittiSourceConfig& k = c->source.kitti;
-  SUNVO_RETURN_IF_ERROR(r.get(m, "source.kitti", "drive_dir", &k.drive_dir));
-  SUNVO_RETURN_IF_ERROR(r.get(m, "source.kitti", "utc_offset_s", &k.utc_offset_s));
-  SUNVO_RETURN_IF_ERROR(r.get(m, "source.kitti", "preload", &k.preload));
-  SUNVO_RETURN_IF_ERROR(r.get(m, "source.kitti", "first_frame", &k.first_frame));
-  SUNVO_RETURN_IF_ERROR(r.get(m, "source.kitti", "last_frame", &k.last_frame));
-  SUNVO_RETURN_IF_ERROR(readEnum(r, m, "source.kitti", "end", kEndNames, &k.end));
-  SUNVO_RETURN_IF_ERROR(r.get(m, "source.kitti", "total_frames", &k.total_frames));
-  SUNVO_RETURN_IF_ERROR(r.section(n, "source", "v4l2", &m));
-  SUNVO_RETURN_IF_ERROR(r.get(m, "source.v4l2", "left_device", &c->source.v4l2.left_device));
-  SUNVO_RETURN_IF_ERROR(r.get(m, "source.v4l2", "right_device", &c->source.v4l2.right_device));
-  SUNVO_RETURN_IF_ERROR(r.get(m, "source.v4l2", "calibration", &c->source.v4l2.calibration));
-  SUNVO_RETURN_IF_ERROR(
-      readEnum(r, m, "source.v4l2", "layout", kLayoutNames, &c->source.v4l2.layout));
-  SUNVO_RETURN_IF_ERROR(readEnum(r, m, "source.v4l2", "pixel_format", kPixelFormatNames,
-                                 &c->source.v4l2.pixel_format));
-  SUNVO_RETURN_IF_ERROR(r.get(m, "source.v4l2", "buffer_count", &c->source.v4l2.buffer_count));
-  SUNVO_RETURN_IF_ERROR(
-      r.get(m, "source.v4l2", "dequeue_timeout_ms", &c->source.v4l2.dequeue_timeout_ms));
-  // trigger
-  SUNVO_RETURN_IF_ERROR(r.section(root, "", "trigger", &n));
-  TriggerConfig& t = c->trigger;
-  SUNVO_RETURN_IF_ERROR(readEnum(r, n, "trigger", "type", kTriggerNames, &t.type));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "trigger", "rate_hz", &t.rate_hz));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "trigger", "follow_recording", &t.follow_recording));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "trigger", "timeout_factor", &t.timeout_factor));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "trigger", "gpio_chip", &t.gpio_chip));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "trigger", "gpio_line", &t.gpio_line));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "trigger", "frame_delay_ms", &t.frame_delay_ms));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "trigger", "match_window_ms", &t.match_window_ms));
-  // frames
-  SUNVO_RETURN_IF_ERROR(r.section(root, "", "frames", &n));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "frames", "width", &c->frames.width));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "frames", "height", &c->frames.height));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "frames", "pool_depth", &c->frames.depth));
-  // queues
-  SUNVO_RETURN_IF_ERROR(r.section(root, "", "queues", &n));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "queues", "frames", &c->queues.frames));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "queues", "sun_requests", &c->queues.sun_requests));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "queues", "sun_results", &c->queues.sun_results));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "queues", "poses", &c->queues.poses));
-  // world
-  SUNVO_RETURN_IF_ERROR(r.section(root, "", "world", &n));
-  WorldConfig& w = c->world;
-  SUNVO_RETURN_IF_ERROR(readEnum(r, n, "world", "init", kWorldNames, &w.init));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "world", "latitude_deg", &w.latitude_deg));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "world", "longitude_deg", &w.longitude_deg));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "world", "altitude_m", &w.altitude_m));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "world", "camera_heading_deg", &w.camera_heading_deg));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "world", "camera_pitch_deg", &w.camera_pitch_deg));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "world", "camera_roll_deg", &w.camera_roll_deg));
-  // estimator
-  SUNVO_RETURN_IF_ERROR(r.section(root, "", "estimator", &n));
-  EstimatorConfig& e = c->estimator;
-  SUNVO_RETURN_IF_ERROR(r.section(n, "estimator", "window", &m));
-  SUNVO_RETURN_IF_ERROR(r.get(m, "estimator.window", "size", &e.window_size));
-  SUNVO_RETURN_IF_ERROR(r.get(m, "estimator.window", "max_iterations", &e.max_iterations));
-  SUNVO_RETURN_IF_ERROR(r.get(m, "estimator.window", "max_solver_time_ms", &e.max_solver_time_ms));
-  SUNVO_RETURN_IF_ERROR(r.get(m, "estimator.window", "min_solver_time_ms", &e.min_solver_time_ms));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "estimator", "deadline_ms", &e.deadline_ms));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "estimator", "publish_margin_ms", &e.publish_margin_ms));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "estimator", "max_features", &e.max_features));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "estimator", "warmup_frames", &e.warmup_frames));
-  // sun
-  SUNVO_RETURN_IF_ERROR(r.section(root, "", "sun", &n));
-  SunConfig& s = c->sun;
-  SUNVO_RETURN_IF_ERROR(readEnum(r, n, "sun", "provider", kSunNames, &s.provider));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "sun", "every_n_frames", &s.every_n_frames));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "sun", "csv", &s.csv));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "sun", "model", &s.model));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "sun", "sigma", &s.sigma));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "sun", "wait_ms", &s.wait_ms));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "sun", "estimate_base_attitude", &s.estimate_base_attitude));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "sun", "max_cosine_distance", &s.max_cosine_distance));
-  SUNVO_RETURN_IF_ERROR(
-      r.get(n, "sun", "initial_attitude_sigma_deg", &s.initial_attitude_sigma_deg));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "sun", "max_drift_deg_per_frame", &s.max_drift_deg_per_frame));
-  // serial
-  SUNVO_RETURN_IF_ERROR(r.section(root, "", "serial", &n));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "serial", "device", &c->serial.device));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "serial", "baud", &c->serial.baud));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "serial", "tx_buffer_bytes", &c->serial.tx_buffer_bytes));
-  // telemetry
-  SUNVO_RETURN_IF_ERROR(r.section(root, "", "telemetry", &n));
-  TelemetryConfig& tm = c->telemetry;
-  SUNVO_RETURN_IF_ERROR(r.get(n, "telemetry", "heartbeat_hz", &tm.heartbeat_hz));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "telemetry", "system_id", &tm.system_id));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "telemetry", "component_id", &tm.component_id));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "telemetry", "position_sigma_m", &tm.position_sigma_m));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "telemetry", "attitude_sigma_deg", &tm.attitude_sigma_deg));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "telemetry", "full_quality_inliers", &tm.full_quality_inliers));
-  // rt
-  SUNVO_RETURN_IF_ERROR(r.section(root, "", "rt", &n));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "rt", "lock_memory", &c->rt.lock_memory));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "rt", "heap_reserve_mb", &c->rt.heap_reserve_mb));
-  SUNVO_RETURN_IF_ERROR(r.section(n, "rt", "threads", &m));
-  SUNVO_RETURN_IF_ERROR(readThread(r, m, "capture", &c->rt.capture));
-  SUNVO_RETURN_IF_ERROR(readThread(r, m, "estimator", &c->rt.estimator));
-  SUNVO_RETURN_IF_ERROR(readThread(r, m, "sun", &c->rt.sun));
-  SUNVO_RETURN_IF_ERROR(readThread(r, m, "telemetry", &c->rt.telemetry));
-  // profiling
-  SUNVO_RETURN_IF_ERROR(r.section(root, "", "profiling", &n));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "profiling", "ring_frames", &c->profiling.ring_frames));
-  SUNVO_RETURN_IF_ERROR(r.get(n, "profiling", "output_dir", &c->profiling.output_dir));
-  return r.checkUnknown(root, "");
-}
+// "key: value" for every field, one per line (the start-up description).
+class DescribeVisitor {
+ public:
+  explicit DescribeVisitor(std::ostringstream& out, std::string prefix = "")
+      : out_(out), prefix_(std::move(prefix)) {}
+
+  template <typename T>
+  void operator()(const char* key, const T& value) {
+    const std::string name = prefix_.empty() ? key : prefix_ + "." + key;
+    if constexpr (OptionsStruct<T>) {
+      DescribeVisitor sub(out_, name);
+      T::fields(value, sub);
+    } else if constexpr (NamedEnum<T>) {
+      out_ << "  " << name << ": " << enumName(value) << "\n";
+    } else if constexpr (std::is_same_v<T, bool>) {
+      out_ << "  " << name << ": " << (value ? "true" : "false") << "\n";
+    } else {
+      out_ << "  " << name << ": " << value << "\n";
+    }
+  }
+
+ private:
+  std::ostringstream& out_;
+  std::string prefix_;
+};
 
 // Deep-merges src into dst (maps merged key by key, anything else replaced).
 void merge(YAML::Node dst, const YAML::Node& src) {
@@ -292,6 +215,34 @@ void merge(YAML::Node dst, const YAML::Node& src) {
 }
 
 }  // namespace
+
+std::span<const std::string_view> enumNames(SourceType) {
+  static constexpr std::string_view kNames[] = {"kitti", "v4l2"};
+  return kNames;
+}
+std::span<const std::string_view> enumNames(TriggerType) {
+  static constexpr std::string_view kNames[] = {"simulated", "gpio"};
+  return kNames;
+}
+std::span<const std::string_view> enumNames(EndAction) {
+  static constexpr std::string_view kNames[] = {"stop", "hold", "loop", "pingpong"};
+  return kNames;
+}
+std::span<const std::string_view> enumNames(WorldInit) {
+  static constexpr std::string_view kNames[] = {"oxts", "config"};
+  return kNames;
+}
+std::span<const std::string_view> enumNames(SunProviderType) {
+  static constexpr std::string_view kNames[] = {"none", "csv", "lalonde", "lalonde_vo", "sun_cnn"};
+  return kNames;
+}
+
+pipeline::SunAidedOptions roverEstimatorDefaults() {
+  pipeline::SunAidedOptions o;
+  o.pipeline.vo.window.max_solver_time_in_seconds = 0.040;
+  o.fusion.max_drift_deg_per_frame = 0.01;
+  return o;
+}
 
 Status RoverConfig::validate() const {
   const KittiSourceConfig& k = source.kitti;
@@ -330,9 +281,9 @@ Status RoverConfig::validate() const {
   SUNVO_RETURN_IF_ERROR(checkQueue("queues.sun_requests", queues.sun_requests, 256));
   SUNVO_RETURN_IF_ERROR(checkQueue("queues.sun_results", queues.sun_results, 256));
   SUNVO_RETURN_IF_ERROR(checkQueue("queues.poses", queues.poses, 1024));
-  if (frames.depth < queues.frames + 2) {
+  if (frames.pool_depth < queues.frames + 2) {
     return invalidArgument(
-        "frames.pool_depth: " + std::to_string(frames.depth) +
+        "frames.pool_depth: " + std::to_string(frames.pool_depth) +
         " must be >= queues.frames + 2 (one slot filling, one in the estimator)");
   }
   SUNVO_RETURN_IF_ERROR(checkRange("world.latitude_deg", world.latitude_deg, -90, 90));
@@ -345,30 +296,31 @@ Status RoverConfig::validate() const {
   if (world.init == WorldInit::kOxts && source.type != SourceType::kKitti) {
     return invalidArgument("world.init: oxts needs source.type: kitti");
   }
-  const EstimatorConfig& e = estimator;
-  SUNVO_RETURN_IF_ERROR(checkRange("estimator.window.size", e.window_size, 2, 8));
-  SUNVO_RETURN_IF_ERROR(checkRange("estimator.window.max_iterations", e.max_iterations, 1, 100));
+  // The estimator's own ranges, named by its keys.
+  if (const Status e = estimator.validate(); !e.isOk()) {
+    return Status(e.code(), "estimator: " + e.message());
+  }
+  if (estimator.pipeline.frontend.max_features > 2000) {
+    return outside("estimator.frontend.max_features", estimator.pipeline.frontend.max_features,
+                   "[16, 2000] (the rover's frame budget)");
+  }
+  const double max_solver_ms = estimator.pipeline.vo.window.max_solver_time_in_seconds * 1e3;
+  SUNVO_RETURN_IF_ERROR(checkRange("estimator.window.max_solver_time_in_seconds",
+                                   estimator.pipeline.vo.window.max_solver_time_in_seconds, 0.001,
+                                   1.0));
+  const RealtimeConfig& rtc = realtime;
   SUNVO_RETURN_IF_ERROR(
-      checkRange("estimator.window.max_solver_time_ms", e.max_solver_time_ms, 1, 1000));
-  SUNVO_RETURN_IF_ERROR(checkRange("estimator.window.min_solver_time_ms", e.min_solver_time_ms, 0.1,
-                                   e.max_solver_time_ms));
-  SUNVO_RETURN_IF_ERROR(checkRange("estimator.deadline_ms", e.deadline_ms, 10, 10000));
-  SUNVO_RETURN_IF_ERROR(checkRange("estimator.publish_margin_ms", e.publish_margin_ms, 0, 1000));
-  SUNVO_RETURN_IF_ERROR(checkRange("estimator.max_features", e.max_features, 16, 2000));
-  SUNVO_RETURN_IF_ERROR(checkRange("estimator.warmup_frames", e.warmup_frames, 0, 100000));
-  SUNVO_RETURN_IF_ERROR(checkRange("sun.every_n_frames", sun.every_n_frames, 1, 1000));
-  SUNVO_RETURN_IF_ERROR(checkOpenLow("sun.sigma", sun.sigma, 0.0, 2.0));
-  SUNVO_RETURN_IF_ERROR(checkRange("sun.wait_ms", sun.wait_ms, 0, 100));
-  SUNVO_RETURN_IF_ERROR(checkRange("sun.max_cosine_distance", sun.max_cosine_distance, 0, 2));
-  SUNVO_RETURN_IF_ERROR(
-      checkOpenLow("sun.initial_attitude_sigma_deg", sun.initial_attitude_sigma_deg, 0.0, 45.0));
-  SUNVO_RETURN_IF_ERROR(
-      checkRange("sun.max_drift_deg_per_frame", sun.max_drift_deg_per_frame, 0.002, 5.0));
+      checkRange("realtime.min_solver_time_ms", rtc.min_solver_time_ms, 0.1, max_solver_ms));
+  SUNVO_RETURN_IF_ERROR(checkRange("realtime.deadline_ms", rtc.deadline_ms, 10, 10000));
+  SUNVO_RETURN_IF_ERROR(checkRange("realtime.publish_margin_ms", rtc.publish_margin_ms, 0, 1000));
+  SUNVO_RETURN_IF_ERROR(checkRange("realtime.warmup_frames", rtc.warmup_frames, 0, 100000));
+  SUNVO_RETURN_IF_ERROR(checkRange("realtime.sun_wait_ms", rtc.sun_wait_ms, 0, 100));
+  SUNVO_RETURN_IF_ERROR(checkOpenLow("sun.csv_sigma", sun.csv_sigma, 0.0, 2.0));
   if (sun.provider == SunProviderType::kCsv && sun.csv.empty()) {
     return invalidArgument("sun.csv: empty, but sun.provider is csv");
   }
   if (sunProviderNeedsColour(sun.provider) && source.type == SourceType::kV4l2) {
-    return invalidArgument("sun.provider: " + kSunNames[static_cast<std::size_t>(sun.provider)] +
+    return invalidArgument("sun.provider: " + std::string(enumName(sun.provider)) +
                            " needs the left colour image; source.type: v4l2 delivers gray");
   }
   if (sun.provider == SunProviderType::kSunCnn && sun.model.empty()) {
@@ -386,10 +338,10 @@ Status RoverConfig::validate() const {
   SUNVO_RETURN_IF_ERROR(
       checkRange("telemetry.full_quality_inliers", telemetry.full_quality_inliers, 1, 100000));
   SUNVO_RETURN_IF_ERROR(checkRange("rt.heap_reserve_mb", rt.heap_reserve_mb, 0, 4096));
-  SUNVO_RETURN_IF_ERROR(rt.capture.validate("rt.threads.capture"));
-  SUNVO_RETURN_IF_ERROR(rt.estimator.validate("rt.threads.estimator"));
-  SUNVO_RETURN_IF_ERROR(rt.sun.validate("rt.threads.sun"));
-  SUNVO_RETURN_IF_ERROR(rt.telemetry.validate("rt.threads.telemetry"));
+  SUNVO_RETURN_IF_ERROR(rt.threads.capture.validate("rt.threads.capture"));
+  SUNVO_RETURN_IF_ERROR(rt.threads.estimator.validate("rt.threads.estimator"));
+  SUNVO_RETURN_IF_ERROR(rt.threads.sun.validate("rt.threads.sun"));
+  SUNVO_RETURN_IF_ERROR(rt.threads.telemetry.validate("rt.threads.telemetry"));
   SUNVO_RETURN_IF_ERROR(checkRange("profiling.ring_frames", profiling.ring_frames, 2, 1048576));
   if (!runtime::isPowerOfTwo(static_cast<std::size_t>(profiling.ring_frames))) {
     return invalidArgument("profiling.ring_frames: " + std::to_string(profiling.ring_frames) +
@@ -400,51 +352,9 @@ Status RoverConfig::validate() const {
 
 std::string RoverConfig::describe() const {
   std::ostringstream o;
-  o << "config " << path << ":\n"
-    << "  source: " << kSourceNames[static_cast<std::size_t>(source.type)];
-  if (source.type == SourceType::kV4l2) {
-    const V4l2SourceConfig& v = source.v4l2;
-    o << " " << kLayoutNames[static_cast<std::size_t>(v.layout)] << " " << v.left_device << " "
-      << v.right_device << " " << kPixelFormatNames[static_cast<std::size_t>(v.pixel_format)]
-      << " buffers=" << v.buffer_count << " calibration=" << v.calibration << "\n";
-  } else {
-    o << " drive_dir=" << source.kitti.drive_dir << " preload=" << source.kitti.preload
-      << " frames=[" << source.kitti.first_frame << ", " << source.kitti.last_frame << "]"
-      << " end=" << kEndNames[static_cast<std::size_t>(source.kitti.end)]
-      << " total_frames=" << source.kitti.total_frames << "\n";
-  }
-  o << "  trigger: " << kTriggerNames[static_cast<std::size_t>(trigger.type)]
-    << " rate_hz=" << trigger.rate_hz << " follow_recording=" << trigger.follow_recording
-    << (trigger.type == TriggerType::kGpio
-            ? " strobe=" + trigger.gpio_chip + ":" + std::to_string(trigger.gpio_line)
-            : std::string())
-    << "\n"
-    << "  frames: " << frames.width << "x" << frames.height << " pool_depth=" << frames.depth
-    << "; queues: frames=" << queues.frames << " sun_requests=" << queues.sun_requests
-    << " sun_results=" << queues.sun_results << " poses=" << queues.poses << "\n"
-    << "  world: " << kWorldNames[static_cast<std::size_t>(world.init)];
-  if (world.init == WorldInit::kConfig) {
-    o << " lat=" << world.latitude_deg << " lon=" << world.longitude_deg
-      << " alt=" << world.altitude_m << " heading=" << world.camera_heading_deg;
-  } else {
-    o << " (origin and first camera pose from the drive's first OXTS record)";
-  }
-  o << "\n"
-    << "  estimator: window=" << estimator.window_size
-    << " max_iterations=" << estimator.max_iterations << " solver_ms=["
-    << estimator.min_solver_time_ms << ", " << estimator.max_solver_time_ms
-    << "] deadline_ms=" << estimator.deadline_ms << " max_features=" << estimator.max_features
-    << "\n"
-    << "  sun: " << kSunNames[static_cast<std::size_t>(sun.provider)]
-    << " every_n_frames=" << sun.every_n_frames << " wait_ms=" << sun.wait_ms << "\n"
-    << "  serial: " << (serial.device.empty() ? "(none)" : serial.device) << " baud=" << serial.baud
-    << "; heartbeat_hz=" << telemetry.heartbeat_hz << "\n"
-    << "  rt: lock_memory=" << rt.lock_memory
-    << " fifo capture/estimator/sun/telemetry=" << rt.capture.fifo_priority << "/"
-    << rt.estimator.fifo_priority << "/" << rt.sun.fifo_priority << "/"
-    << rt.telemetry.fifo_priority << "\n"
-    << "  profiling: ring_frames=" << profiling.ring_frames
-    << " output_dir=" << profiling.output_dir << "\n";
+  o << "config " << path << ":\n";
+  DescribeVisitor v(o);
+  fields(*this, v);
   return o.str();
 }
 
@@ -481,7 +391,10 @@ Expected<RoverConfig> loadRoverConfig(
   RoverConfig config;
   config.path = path;
   Reader reader(path);
-  SUNVO_RETURN_IF_ERROR(readAll(reader, root, &config));
+  ReadVisitor visitor(reader, root, "");
+  RoverConfig::fields(config, visitor);
+  SUNVO_RETURN_IF_ERROR(visitor.status());
+  SUNVO_RETURN_IF_ERROR(reader.checkUnknown(root, ""));
   const Status s = config.validate();
   if (!s.isOk()) return Status(s.code(), path + ": " + s.message());
   return config;

@@ -85,23 +85,22 @@ Expected<std::unique_ptr<KittiReplaySource>> KittiReplaySource::open(
   if (!config.preload && (config.end == EndAction::kLoop || config.end == EndAction::kPingPong)) {
     return invalidArgument("source.kitti.end: loop and pingpong need source.kitti.preload: true");
   }
-  kitti::KittiSourceOptions o;
-  o.root = config.drive_dir;
-  o.layout = kitti::KittiLayout::kRaw;
-  o.utc_offset_s = config.utc_offset_s;
-  o.first_frame = config.first_frame;
-  o.last_frame = config.last_frame;
+  dataset::DatasetOptions d;
+  d.path = config.drive_dir;
+  d.utc_offset_s = config.utc_offset_s;
+  d.first_frame = config.first_frame;
+  d.last_frame = config.last_frame;
+  auto ds = dataset::Dataset::open(d);
+  if (!ds) return ds.status();
+  if (!ds->hasImages()) return invalidArgument(config.drive_dir + ": no images");
+  kitti::KittiSourceOptions o = ds->imageSourceOptions();
   o.use_color = color;
   std::unique_ptr<KittiReplaySource> src(new KittiReplaySource());
   src->config_ = config;
+  src->camera_ = ds->camera();
+  src->dataset_.emplace(std::move(*ds));
   auto live = kitti::KittiStereoSource::open(o);
   if (!live) return live.status();
-  src->camera_ = live->camera();
-  src->calib_dir_ = live->calibrationDir();
-  const std::int64_t last = config.last_frame < 0 ? live->frameCount() - 1 : config.last_frame;
-  for (std::int64_t i = config.first_frame; i <= last; ++i) {
-    src->range_times_.push_back(live->frameTimes()[static_cast<std::size_t>(i)]);
-  }
   if (config.preload) {
     auto all = kitti::loadAllFrames(o);
     if (!all) return all.status();

@@ -1,7 +1,6 @@
 #include "sunvo/rover/sun_provider.hpp"
 
-#include "sunvo/suncnn/sun_cnn_estimator.hpp"
-#include "sunvo/sunvision/lalonde_estimator.hpp"
+#include "sunvo/sunestimators/sun_estimators.hpp"
 
 namespace sunvo::rover {
 
@@ -38,18 +37,6 @@ Expected<std::optional<sunfusion::SunMeasurement>> ImageSunProvider::measure(con
   return std::optional<sunfusion::SunMeasurement>(m);
 }
 
-namespace {
-Expected<std::unique_ptr<SunProvider>> lalonde(sunvision::LalondePrior prior,
-                                               const StereoCamera& camera) {
-  sunvision::LalondeOptions options;
-  options.prior = prior;
-  auto e = std::make_unique<sunvision::LalondeEstimator>(options);
-  const Status s = e->init();
-  if (!s.isOk()) return Status(s.code(), "sun.provider: " + s.message());
-  return std::unique_ptr<SunProvider>(new ImageSunProvider(std::move(e), camera));
-}
-}  // namespace
-
 Expected<std::unique_ptr<SunProvider>> makeSunProvider(const SunConfig& config,
                                                        const StereoCamera& camera) {
   switch (config.provider) {
@@ -58,17 +45,20 @@ Expected<std::unique_ptr<SunProvider>> makeSunProvider(const SunConfig& config,
     case SunProviderType::kCsv: {
       auto csv = files::readSunCsv(config.csv);
       if (!csv) return Status(csv.status().code(), "sun.csv: " + csv.status().message());
-      return std::unique_ptr<SunProvider>(new CsvSunProvider(std::move(*csv), config.sigma));
+      return std::unique_ptr<SunProvider>(new CsvSunProvider(std::move(*csv), config.csv_sigma));
     }
     case SunProviderType::kLalonde:
-      return lalonde(sunvision::LalondePrior::kZenith, camera);
     case SunProviderType::kLalondeVo:
-      return lalonde(sunvision::LalondePrior::kVisualOdometry, camera);
     case SunProviderType::kSunCnn: {
-      auto e = std::make_unique<suncnn::SunCnnEstimator>();
-      const Status s = e->init(suncnn::SunCnnOptions{}, config.model);
-      if (!s.isOk()) return Status(s.code(), "sun.model: " + s.message());
-      return std::unique_ptr<SunProvider>(new ImageSunProvider(std::move(e), camera));
+      // The image estimators: the one factory every program uses, by the provider's name.
+      auto e =
+          sunestimators::makeSunEstimator(std::string(enumName(config.provider)), config.model);
+      if (!e) {
+        const char* key =
+            config.provider == SunProviderType::kSunCnn ? "sun.model: " : "sun.provider: ";
+        return Status(e.status().code(), key + e.status().message());
+      }
+      return std::unique_ptr<SunProvider>(new ImageSunProvider(std::move(*e), camera));
     }
   }
   return invalidArgument("sun.provider: unknown");

@@ -12,17 +12,18 @@ Status FramePoolOptions::validate() const {
   if (height < 16 || height > 8192) {
     return invalidArgument("frames.height: " + std::to_string(height) + " is outside [16, 8192]");
   }
-  if (depth < 2 || depth > 256) {
-    return invalidArgument("frames.pool_depth: " + std::to_string(depth) + " is outside [2, 256]");
+  if (pool_depth < 2 || pool_depth > 256) {
+    return invalidArgument("frames.pool_depth: " + std::to_string(pool_depth) +
+                           " is outside [2, 256]");
   }
   return Status::ok();
 }
 
 FramePool::FramePool(const FramePoolOptions& options)
     : options_(options),
-      slots_(static_cast<std::size_t>(options.depth)),
-      free_(static_cast<std::size_t>(options.depth)),
-      returns_(static_cast<std::size_t>(options.depth), QueuePolicy::kReject) {}
+      slots_(static_cast<std::size_t>(options.pool_depth)),
+      free_(static_cast<std::size_t>(options.pool_depth)),
+      returns_(static_cast<std::size_t>(options.pool_depth), QueuePolicy::kReject) {}
 
 Expected<std::unique_ptr<FramePool>> FramePool::create(const FramePoolOptions& options) {
   SUNVO_RETURN_IF_ERROR(options.validate());

@@ -29,6 +29,7 @@
 #include <functional>
 #include <memory>
 #include <span>
+#include <string_view>
 #include <vector>
 
 #include "sunvo/backend/stereo_residual.hpp"
@@ -40,6 +41,10 @@
 namespace sunvo::backend {
 
 enum class RobustLoss { kNone, kHuber, kCauchy };
+inline std::span<const std::string_view> enumNames(RobustLoss) {
+  static constexpr std::string_view kNames[] = {"none", "huber", "cauchy"};
+  return kNames;
+}
 
 struct WindowOptions {
   int window_size = 2;                    // poses, [2, kMaxWindowSize]
@@ -59,6 +64,22 @@ struct WindowOptions {
   double motion_prior_sigma_trans_m = 0.0;  // m, >= 0: std of the translation deviation
 
   Status validate() const;
+  template <class Self, class V>
+  static void fields(Self& s, V& v) {
+    v("window_size", s.window_size);
+    v("max_observations_per_frame", s.max_observations_per_frame);
+    v("max_landmarks", s.max_landmarks);
+    v("sigma_u_px", s.sigma_u_px);
+    v("sigma_v_px", s.sigma_v_px);
+    v("sigma_d_px", s.sigma_d_px);
+    v("loss", s.loss);
+    v("loss_scale", s.loss_scale);
+    v("min_disparity_px", s.min_disparity_px);
+    v("max_num_iterations", s.max_num_iterations);
+    v("max_solver_time_in_seconds", s.max_solver_time_in_seconds);
+    v("motion_prior_sigma_rot_deg", s.motion_prior_sigma_rot_deg);
+    v("motion_prior_sigma_trans_m", s.motion_prior_sigma_trans_m);
+  }
 };
 
 // One measurement of the window: landmark id and (u, v, d) in px.

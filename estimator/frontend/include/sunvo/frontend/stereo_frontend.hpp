@@ -66,6 +66,27 @@ struct FrontendOptions {
   int lr_tolerance = 1;                // px, [0, 10]: left->right->left check for new features
 
   Status validate() const;
+  template <class Self, class V>
+  static void fields(Self& s, V& v) {
+    v("max_width", s.max_width);
+    v("max_height", s.max_height);
+    v("nms_radius", s.nms_radius);
+    v("blob_threshold", s.blob_threshold);
+    v("corner_threshold", s.corner_threshold);
+    v("max_candidates", s.max_candidates);
+    v("max_features", s.max_features);
+    v("bucket_width", s.bucket_width);
+    v("bucket_height", s.bucket_height);
+    v("max_per_bucket", s.max_per_bucket);
+    v("min_disparity", s.min_disparity);
+    v("max_disparity", s.max_disparity);
+    v("stereo_row_tolerance", s.stereo_row_tolerance);
+    v("search_radius", s.search_radius);
+    v("predicted_search_radius", s.predicted_search_radius);
+    v("max_sad", s.max_sad);
+    v("circular_tolerance_px", s.circular_tolerance_px);
+    v("lr_tolerance", s.lr_tolerance);
+  }
 };
 
 // What the last process() call did. *_ns: wall time (monotonic clock); *_cpu_ns: CPU time of the

@@ -25,6 +25,16 @@ struct RansacOptions {
   int max_observations = 2000;       // count, >= 3: buffer size; more matches than this -> error
 
   Status validate() const;
+  template <class Self, class V>
+  static void fields(Self& s, V& v) {
+    v("max_iterations", s.max_iterations);
+    v("confidence", s.confidence);
+    v("inlier_threshold_px", s.inlier_threshold_px);
+    v("min_inliers", s.min_inliers);
+    v("refine_iterations", s.refine_iterations);
+    v("min_disparity_px", s.min_disparity_px);
+    v("max_observations", s.max_observations);
+  }
 };
 
 // One landmark seen in both frames: left (u, v) and right u in frame k-1 and in frame k.

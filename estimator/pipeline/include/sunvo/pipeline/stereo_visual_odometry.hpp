@@ -52,6 +52,14 @@ struct PipelineOptions {
 
   // The error names the bad key ("frontend option 'x'", "vo.x", "pipeline.x").
   Status validate() const;
+  // The back end's fields are listed at this level (estimator.window.*, estimator.ransac.*).
+  template <class Self, class V>
+  static void fields(Self& s, V& v) {
+    v("frontend", s.frontend);
+    vo::VoOptions::fields(s.vo, v);
+    v("rotation_hint", s.rotation_hint);
+    v("max_hint_px", s.max_hint_px);
+  }
 };
 
 // Times of one process() call, ms: wall time (monotonic clock) and CPU time of the calling thread

@@ -38,6 +38,14 @@ struct SunAidedOptions {
 
   // The error names the bad key ("sun_aided.every_n_frames", "pipeline.*", "sun_fusion.*").
   Status validate() const;
+  // The pipeline's fields are listed at this level; use_sun is the program's to set (the rover:
+  // sun.provider).
+  template <class Self, class V>
+  static void fields(Self& s, V& v) {
+    PipelineOptions::fields(s.pipeline, v);
+    v("every_n_frames", s.every_n_frames);
+    v("fusion", s.fusion);
+  }
 };
 
 enum class OdometryInput { kImages, kFeatures };

@@ -11,6 +11,8 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <span>
+#include <string_view>
 
 #include "sunvo/core/status.hpp"
 #include "sunvo/sunfusion/sun_measurement.hpp"
@@ -18,6 +20,10 @@
 namespace sunvo::sunfusion {
 
 enum class GatePlane { kFull3d, kXZ };
+inline std::span<const std::string_view> enumNames(GatePlane) {
+  static constexpr std::string_view kNames[] = {"full_3d", "xz"};
+  return kNames;
+}
 
 struct SunGateOptions {
   double max_cosine_distance = 0.3;      // reject above, [0, 2]; 2 disables
@@ -26,6 +32,13 @@ struct SunGateOptions {
   double min_sun_elevation_deg = 0.0;    // ignore measurements while the sun is lower, [-5, 60] deg
 
   Status validate() const;
+  template <class Self, class V>
+  static void fields(Self& s, V& v) {
+    v("max_cosine_distance", s.max_cosine_distance);
+    v("plane", s.plane);
+    v("max_vertical_error", s.max_vertical_error);
+    v("min_sun_elevation_deg", s.min_sun_elevation_deg);
+  }
 };
 
 enum class GateResult {

@@ -53,6 +53,8 @@
 #include <array>
 #include <memory>
 #include <optional>
+#include <span>
+#include <string_view>
 
 #include "sunvo/backend/bundle_window.hpp"
 #include "sunvo/sunfusion/sun_gate.hpp"
@@ -66,6 +68,10 @@ struct SunObservation {
 };
 
 enum class DriftAdaptation { kFixed, kPersistence, kInnovationMedian };
+inline std::span<const std::string_view> enumNames(DriftAdaptation) {
+  static constexpr std::string_view kNames[] = {"fixed", "persistence", "innovation_median"};
+  return kNames;
+}
 
 struct SunFusionOptions {
   SunGateOptions gate;
@@ -103,6 +109,24 @@ struct SunFusionOptions {
   double innovation_gate_chi2 = 16.3;
 
   Status validate() const;
+  template <class Self, class V>
+  static void fields(Self& s, V& v) {
+    v("gate", s.gate);
+    v("loss_scale", s.loss_scale);
+    v("estimate_base_attitude", s.estimate_base_attitude);
+    v("initial_attitude_sigma_deg", s.initial_attitude_sigma_deg);
+    v("attitude_drift_deg_per_frame", s.attitude_drift_deg_per_frame);
+    v("drift_adaptation", s.drift_adaptation);
+    v("min_drift_deg_per_frame", s.min_drift_deg_per_frame);
+    v("max_drift_deg_per_frame", s.max_drift_deg_per_frame);
+    v("drift_adaptation_rate", s.drift_adaptation_rate);
+    v("persistence_forgetting", s.persistence_forgetting);
+    v("persistence_false_alarm", s.persistence_false_alarm);
+    v("persistence_step_up", s.persistence_step_up);
+    v("persistence_step_down", s.persistence_step_down);
+    v("persistence_huber", s.persistence_huber);
+    v("innovation_gate_chi2", s.innovation_gate_chi2);
+  }
 };
 
 class SunWindowTerm {

@@ -42,6 +42,16 @@ struct VoOptions {
   std::uint64_t seed = 0x5eed;                // RANSAC seed; frame k uses a hash of (seed, k)
 
   Status validate() const;
+  template <class Self, class V>
+  static void fields(Self& s, V& v) {
+    v("ransac", s.ransac);
+    v("window", s.window);
+    v("max_observations", s.max_observations);
+    v("use_window", s.use_window);
+    v("constant_velocity_on_loss", s.constant_velocity_on_loss);
+    v("max_translation_per_frame_m", s.max_translation_per_frame_m);
+    v("seed", s.seed);
+  }
 };
 
 struct VoResult {

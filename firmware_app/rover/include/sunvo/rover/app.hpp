@@ -6,12 +6,13 @@
 //                        |                                        ^
 //                        +--> [sun requests] --sun--> [sun results]
 //
+// One class per stage (src/stages.hpp); RoverApp only wires them and owns their threads.
 // capture:   waits for a trigger, takes a free pool slot, grabs the stereo pair into it, queues
 //            the slot index; every n-th frame also queues a sun request (frame time, index).
-// estimator: pipeline::StereoVisualOdometry + sunfusion::SunWindowTerm. Before each frame it
-//            takes the sun results that arrived; for a sun frame it waits at most sun.wait_ms
-//            for that frame's result (the window, size 2, keeps the frame's rotation free only
-//            while it is the newest). The solver's time budget shrinks when the frame is late:
+// estimator: pipeline::SunAidedOdometry. Before each frame it hands over the sun results that
+//            arrived; for a sun frame it waits at most realtime.sun_wait_ms for that frame's
+//            result (the window, size 2, keeps the frame's rotation free only while it is the
+//            newest). The solver's time budget shrinks when the frame is late:
 //              budget = clamp(deadline - age - (front end + RANSAC, running mean) - margin,
 //                             min_solver_time, max_solver_time),  age = dequeue - trigger.
 // sun:       NREL SPA at the configured position and frame UTC -> sun in the ENU world; the
@@ -19,7 +20,7 @@
 //            path (low priority; a late result is counted and dropped by the window).
 // telemetry: each pose -> PoseLink (MAVLink ODOMETRY), HEARTBEAT at heartbeat_hz; the time the
 //            frame's last byte left is the frame's publish stamp; trigger -> last byte above
-//            estimator.deadline_ms is a deadline miss.
+//            realtime.deadline_ms is a deadline miss.
 // Every buffer is allocated in create(); the capture and telemetry loops allocate nothing per
 // frame (measured by the allocation meters when the executable installs a probe).
 

@@ -2,20 +2,38 @@
 // The configuration of sunvo_rover: one YAML file (config/rover.yaml on the rover,
 // config/rover_replay.yaml for a replay), read and validated once at start-up.
 //
-// Every option has a default (below), with its unit and range. Unknown keys are rejected; a bad
-// value names its key and the file ("config/rover.yaml: estimator.window.max_iterations: 0 is
-// outside [1, 100]"); a value of the wrong type also names the line. Command-line overrides use
-// the same keys ("--set source.kitti.drive_dir=/data/drive").
+// One vocabulary: every key is the name of a struct field, listed once in the struct's fields()
+// (core/fields.hpp); the `estimator` section is the estimator's own pipeline::SunAidedOptions
+// (estimator.window.max_num_iterations, estimator.frontend.max_features, estimator.fusion.*).
+// Every option has a default (below or in its struct), with its unit and range. Unknown keys are
+// rejected; a bad value names its key and the file ("config/rover.yaml: estimator: window.x must
+// be ..."); a value of the wrong type also names the line. Command-line overrides use the same
+// keys ("--set source.kitti.drive_dir=/data/drive").
 
 #include <cstdint>
+#include <span>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
+#include "sunvo/core/fields.hpp"
 #include "sunvo/core/status.hpp"
+#include "sunvo/pipeline/sun_aided_odometry.hpp"
 #include "sunvo/runtime/frame_pool.hpp"
 #include "sunvo/runtime/rt_setup.hpp"
 #include "sunvo/v4l2/stereo_source.hpp"
+
+namespace sunvo::v4l2 {
+inline std::span<const std::string_view> enumNames(V4l2Layout) {
+  static constexpr std::string_view kNames[] = {"two_devices", "side_by_side"};
+  return kNames;
+}
+inline std::span<const std::string_view> enumNames(V4l2PixelFormat) {
+  static constexpr std::string_view kNames[] = {"grey", "yuyv"};
+  return kNames;
+}
+}  // namespace sunvo::v4l2
 
 namespace sunvo::rover {
 
@@ -36,6 +54,12 @@ enum class WorldInit {
 // zenith / the VO attitude as prior; sun_cnn: suncnn::SunCnnEstimator (ONNX model at sun.model).
 enum class SunProviderType { kNone, kCsv, kLalonde, kLalondeVo, kSunCnn };
 
+std::span<const std::string_view> enumNames(SourceType);
+std::span<const std::string_view> enumNames(TriggerType);
+std::span<const std::string_view> enumNames(EndAction);
+std::span<const std::string_view> enumNames(WorldInit);
+std::span<const std::string_view> enumNames(SunProviderType);
+
 struct KittiSourceConfig {
   std::string drive_dir;          // KITTI raw drive folder (<date>/<date>_drive_NNNN_sync)
   std::int64_t utc_offset_s = 0;  // s, [-50400, 50400]: offset of the timestamps to UTC
@@ -43,8 +67,17 @@ struct KittiSourceConfig {
   std::int64_t first_frame = 0;   // index, >= 0
   std::int64_t last_frame = -1;   // index, >= first_frame; -1 = the last one
   EndAction end = EndAction::kStop;
-  std::int64_t total_frames =
-      0;  // frames, >= 0: stop after this many (loop / pingpong); 0 = no limit
+  std::int64_t total_frames = 0;  // frames, >= 0: stop after this many (loop / pingpong); 0 = all
+  template <class Self, class V>
+  static void fields(Self& s, V& v) {
+    v("drive_dir", s.drive_dir);
+    v("utc_offset_s", s.utc_offset_s);
+    v("preload", s.preload);
+    v("first_frame", s.first_frame);
+    v("last_frame", s.last_frame);
+    v("end", s.end);
+    v("total_frames", s.total_frames);
+  }
 };
 
 struct V4l2SourceConfig {
@@ -55,12 +88,28 @@ struct V4l2SourceConfig {
   v4l2::V4l2PixelFormat pixel_format = v4l2::V4l2PixelFormat::kGrey;  // grey | yuyv
   int buffer_count = 4;          // MMAP buffers per device, [2, 32]
   int dequeue_timeout_ms = 200;  // ms, [1, 60000]: the longest wait for one stereo pair
+  template <class Self, class V>
+  static void fields(Self& s, V& v) {
+    v("left_device", s.left_device);
+    v("right_device", s.right_device);
+    v("calibration", s.calibration);
+    v("layout", s.layout);
+    v("pixel_format", s.pixel_format);
+    v("buffer_count", s.buffer_count);
+    v("dequeue_timeout_ms", s.dequeue_timeout_ms);
+  }
 };
 
 struct SourceConfig {
   SourceType type = SourceType::kKitti;
   KittiSourceConfig kitti;
   V4l2SourceConfig v4l2;
+  template <class Self, class V>
+  static void fields(Self& s, V& v) {
+    v("type", s.type);
+    v("kitti", s.kitti);
+    v("v4l2", s.v4l2);
+  }
 };
 
 struct TriggerConfig {
@@ -73,6 +122,17 @@ struct TriggerConfig {
   int gpio_line = 0;                    // gpio: line offset, [0, 1023] (the strobe input)
   double frame_delay_ms = 0.0;    // gpio: ms, [-1000, 1000]: frame buffer timestamp - strobe edge
   double match_window_ms = 10.0;  // gpio: ms, [0, half a period]: largest pairing error
+  template <class Self, class V>
+  static void fields(Self& s, V& v) {
+    v("type", s.type);
+    v("rate_hz", s.rate_hz);
+    v("follow_recording", s.follow_recording);
+    v("timeout_factor", s.timeout_factor);
+    v("gpio_chip", s.gpio_chip);
+    v("gpio_line", s.gpio_line);
+    v("frame_delay_ms", s.frame_delay_ms);
+    v("match_window_ms", s.match_window_ms);
+  }
 };
 
 struct QueueConfig {
@@ -80,6 +140,13 @@ struct QueueConfig {
   int sun_requests = 4;  // capture -> sun, power of two [1, 256], drop-oldest
   int sun_results = 4;   // sun -> estimator, power of two [1, 256], drop-oldest
   int poses = 16;        // estimator -> telemetry, power of two [1, 1024], drop-oldest
+  template <class Self, class V>
+  static void fields(Self& s, V& v) {
+    v("frames", s.frames);
+    v("sun_requests", s.sun_requests);
+    v("sun_results", s.sun_results);
+    v("poses", s.poses);
+  }
 };
 
 struct WorldConfig {
@@ -92,42 +159,64 @@ struct WorldConfig {
   double camera_heading_deg = 0.0;  // deg, [-360, 360]
   double camera_pitch_deg = 0.0;    // deg, [-90, 90]
   double camera_roll_deg = 0.0;     // deg, [-180, 180]
+  template <class Self, class V>
+  static void fields(Self& s, V& v) {
+    v("init", s.init);
+    v("latitude_deg", s.latitude_deg);
+    v("longitude_deg", s.longitude_deg);
+    v("altitude_m", s.altitude_m);
+    v("camera_heading_deg", s.camera_heading_deg);
+    v("camera_pitch_deg", s.camera_pitch_deg);
+    v("camera_roll_deg", s.camera_roll_deg);
+  }
 };
 
-struct EstimatorConfig {
-  int window_size = 2;               // poses, [2, 8]
-  int max_iterations = 10;           // Ceres iterations per solve, [1, 100]
-  double max_solver_time_ms = 40.0;  // ms, [1, 1000]: the solver budget of an on-time frame
-  double min_solver_time_ms = 5.0;  // ms, [0.1, max_solver_time_ms]: the budget never shrinks below
-  double deadline_ms = 100.0;       // ms, [10, 10000]: trigger -> pose sent; later = a miss
-  double publish_margin_ms = 5.0;   // ms, [0, 1000]: kept for telemetry when budgeting the solver
-  int max_features = 2000;          // per frame, [16, 2000]
-  int warmup_frames = 50;           // frames, [0, 100000]: not counted in the allocation meters
+// The real-time loop around the estimator (the estimator's own options are `estimator`).
+struct RealtimeConfig {
+  double deadline_ms = 100.0;      // ms, [10, 10000]: trigger -> pose sent; later = a miss
+  double publish_margin_ms = 5.0;  // ms, [0, 1000]: kept for telemetry when budgeting the solver
+  // ms, [0.1, estimator.window.max_solver_time_in_seconds * 1000]: the solver's budget of a late
+  // frame never shrinks below this (an on-time frame gets max_solver_time_in_seconds)
+  double min_solver_time_ms = 5.0;
+  int warmup_frames = 50;    // frames, [0, 100000]: not counted in the allocation meters
+  double sun_wait_ms = 5.0;  // ms, [0, 100]: the estimator waits at most this long for a sun
+                             //   frame's measurement (0 = never waits)
+  template <class Self, class V>
+  static void fields(Self& s, V& v) {
+    v("deadline_ms", s.deadline_ms);
+    v("publish_margin_ms", s.publish_margin_ms);
+    v("min_solver_time_ms", s.min_solver_time_ms);
+    v("warmup_frames", s.warmup_frames);
+    v("sun_wait_ms", s.sun_wait_ms);
+  }
 };
 
+// Where sun measurements come from; how they are fused is estimator.every_n_frames and
+// estimator.fusion.*.
 struct SunConfig {
   SunProviderType provider = SunProviderType::kNone;
-  int every_n_frames = 5;  // a measurement every n-th frame, [1, 1000]
-  std::string csv;         // csv provider: "frame,sx,sy,sz" per recording frame
-  std::string model;       // sun_cnn provider: the ONNX model file (e.g. /etc/sunvo/sun_cnn.onnx)
-  double sigma = 0.05;     // csv provider: measurement sigma (R_s = sigma^2 I), (0, 2]
-  double wait_ms = 5.0;    // ms, [0, 100]: the estimator waits at most this long for a
-                           //   sun frame's measurement (0 = never waits)
-  bool estimate_base_attitude = true;  // see sunfusion::SunFusionOptions
-  double max_cosine_distance = 0.3;    // gate, [0, 2]
-  // deg, (0, 45]: attitude std of the start pose (from the INS / level and heading at start-up)
-  double initial_attitude_sigma_deg = 1.0;
-  // deg/frame, [0.002, 5]: cap of the adapted attitude random walk (docs/experiment.md). 0.01
-  // for the image estimators, whose errors are correlated along a street (docs/sun_estimators.md,
-  // benchmark drives); raise it (0.05) for a source whose errors are independent from frame to
-  // frame (a sun sensor, the csv provider with the true sun)
-  double max_drift_deg_per_frame = 0.01;
+  std::string csv;          // csv provider: "frame,sx,sy,sz" per recording frame
+  double csv_sigma = 0.05;  // csv provider: measurement sigma (R_s = sigma^2 I), (0, 2]
+  std::string model;        // sun_cnn provider: the ONNX model file (e.g. /etc/sunvo/sun_cnn.onnx)
+  template <class Self, class V>
+  static void fields(Self& s, V& v) {
+    v("provider", s.provider);
+    v("csv", s.csv);
+    v("csv_sigma", s.csv_sigma);
+    v("model", s.model);
+  }
 };
 
 struct SerialConfig {
   std::string device;           // serial port (e.g. /dev/ttyS1, a pty); empty = no pose stream
   int baud = 921600;            // bit/s, a termios speed
   int tx_buffer_bytes = 16384;  // bytes, [1024, 1048576]: frames waiting for the port
+  template <class Self, class V>
+  static void fields(Self& s, V& v) {
+    v("device", s.device);
+    v("baud", s.baud);
+    v("tx_buffer_bytes", s.tx_buffer_bytes);
+  }
 };
 
 struct TelemetryConfig {
@@ -137,6 +226,29 @@ struct TelemetryConfig {
   double position_sigma_m = 0.1;    // m, (0, 1000]: reported position std when tracking
   double attitude_sigma_deg = 1.0;  // deg, (0, 180]: reported attitude std when tracking
   int full_quality_inliers = 150;   // RANSAC inliers that count as quality 100, [1, 100000]
+  template <class Self, class V>
+  static void fields(Self& s, V& v) {
+    v("heartbeat_hz", s.heartbeat_hz);
+    v("system_id", s.system_id);
+    v("component_id", s.component_id);
+    v("position_sigma_m", s.position_sigma_m);
+    v("attitude_sigma_deg", s.attitude_sigma_deg);
+    v("full_quality_inliers", s.full_quality_inliers);
+  }
+};
+
+struct ThreadsConfig {
+  runtime::ThreadPolicy capture{80, -1};
+  runtime::ThreadPolicy estimator{70, -1};
+  runtime::ThreadPolicy sun{20, -1};
+  runtime::ThreadPolicy telemetry{75, -1};
+  template <class Self, class V>
+  static void fields(Self& s, V& v) {
+    v("capture", s.capture);
+    v("estimator", s.estimator);
+    v("sun", s.sun);
+    v("telemetry", s.telemetry);
+  }
 };
 
 struct RtConfig {
@@ -144,16 +256,30 @@ struct RtConfig {
   // MiB, [0, 4096]: heap made resident at start-up for the estimator's per-frame allocations
   // (one malloc arena, no mmap blocks, no trimming; see runtime::configureRealTimeHeap); 0 = off
   int heap_reserve_mb = 64;
-  runtime::ThreadPolicy capture{80, -1};
-  runtime::ThreadPolicy estimator{70, -1};
-  runtime::ThreadPolicy sun{20, -1};
-  runtime::ThreadPolicy telemetry{75, -1};
+  ThreadsConfig threads;
+  template <class Self, class V>
+  static void fields(Self& s, V& v) {
+    v("lock_memory", s.lock_memory);
+    v("heap_reserve_mb", s.heap_reserve_mb);
+    v("threads", s.threads);
+  }
 };
 
 struct ProfilingConfig {
   int ring_frames = 8192;                // frames, power of two [2, 1048576]: stage stamps kept
   std::string output_dir = "out/rover";  // CSV, trace and summary go here (created)
+  template <class Self, class V>
+  static void fields(Self& s, V& v) {
+    v("ring_frames", s.ring_frames);
+    v("output_dir", s.output_dir);
+  }
 };
+
+// The estimator's defaults on a rover: a 40 ms solver budget for an on-time frame, and the image
+// estimators' attitude random-walk cap of 0.01 deg/frame (their errors are correlated along a
+// street: docs/sun_estimators.md, benchmark drives; raise it, e.g. 0.05, for a source whose errors
+// are independent from frame to frame, such as a sun sensor or the csv provider's true sun).
+pipeline::SunAidedOptions roverEstimatorDefaults();
 
 struct RoverConfig {
   std::string path;  // the file it was read from
@@ -162,7 +288,8 @@ struct RoverConfig {
   runtime::FramePoolOptions frames;
   QueueConfig queues;
   WorldConfig world;
-  EstimatorConfig estimator;
+  pipeline::SunAidedOptions estimator = roverEstimatorDefaults();
+  RealtimeConfig realtime;
   SunConfig sun;
   SerialConfig serial;
   TelemetryConfig telemetry;
@@ -173,6 +300,21 @@ struct RoverConfig {
   Status validate() const;
   // The options as "key: value" lines, printed once at start-up.
   std::string describe() const;
+  template <class Self, class V>
+  static void fields(Self& s, V& v) {
+    v("source", s.source);
+    v("trigger", s.trigger);
+    v("frames", s.frames);
+    v("queues", s.queues);
+    v("world", s.world);
+    v("estimator", s.estimator);
+    v("realtime", s.realtime);
+    v("sun", s.sun);
+    v("serial", s.serial);
+    v("telemetry", s.telemetry);
+    v("rt", s.rt);
+    v("profiling", s.profiling);
+  }
 };
 
 // Reads the file, applies overrides ("key.path", "value") on top, rejects unknown keys, checks

@@ -16,6 +16,7 @@
 #include "sunvo/core/camera.hpp"
 #include "sunvo/core/status.hpp"
 #include "sunvo/core/stereo_frame.hpp"
+#include "sunvo/dataset/dataset.hpp"
 #include "sunvo/kitti/stereo_source.hpp"
 #include "sunvo/rover/config.hpp"
 #include "sunvo/runtime/frame_pool.hpp"
@@ -99,7 +100,9 @@ class SimulatedTrigger final : public TriggerSource {
   TimeNs start_mono_ns_ = 0;
 };
 
-// A KITTI raw drive as the camera: with preload every frame of the range is decoded at start-up
+// A KITTI raw drive (or a sunvo render) as the camera, opened through the dataset seam
+// (drivers/dataset), which also gives the world: the origin and the first camera pose from the
+// first OXTS record of the range. With preload every frame of the range is decoded at start-up
 // and grab() copies it into the slot (no decoding, no allocation per frame); without preload
 // grab() decodes the next files (stop/hold only; libpng allocates per frame).
 class KittiReplaySource final : public FrameSource {
@@ -110,8 +113,8 @@ class KittiReplaySource final : public FrameSource {
   const StereoCamera& camera() const override { return camera_; }
   Status grab(const TriggerEvent& trigger, runtime::FrameSlot& slot) override;
 
-  const std::vector<TimeNs>& rangeTimes() const { return range_times_; }
-  const std::string& calibrationDir() const { return calib_dir_; }
+  const std::vector<TimeNs>& rangeTimes() const { return dataset_->timesNs(); }
+  const dataset::Dataset& dataset() const { return *dataset_; }
   void setSchedule(std::shared_ptr<const ReplaySchedule> schedule) {
     schedule_ = std::move(schedule);
   }
@@ -120,8 +123,7 @@ class KittiReplaySource final : public FrameSource {
   KittiReplaySource() = default;
   KittiSourceConfig config_;
   StereoCamera camera_;
-  std::string calib_dir_;
-  std::vector<TimeNs> range_times_;
+  std::optional<dataset::Dataset> dataset_;
   std::vector<StereoFrame> preloaded_;            // preload: the whole range
   std::optional<kitti::KittiStereoSource> live_;  // no preload: decoded per grab
   std::shared_ptr<const ReplaySchedule> schedule_;

@@ -20,9 +20,15 @@ namespace sunvo::runtime {
 struct FramePoolOptions {
   int width = 1242;    // px, [16, 8192]: image width
   int height = 375;    // px, [16, 8192]: image height
-  int depth = 8;       // slots, [2, 256]: frames alive at once (queued + in use)
-  bool color = false;  // also a CV_8UC3 left/right colour pair per slot
+  int pool_depth = 8;  // slots, [2, 256]: frames alive at once (queued + in use)
+  bool color = false;  // also a CV_8UC3 left/right colour pair per slot (set by the program)
   Status validate() const;
+  template <class Self, class V>
+  static void fields(Self& s, V& v) {
+    v("width", s.width);
+    v("height", s.height);
+    v("pool_depth", s.pool_depth);
+  }
 };
 
 // Data about one frame besides its images.

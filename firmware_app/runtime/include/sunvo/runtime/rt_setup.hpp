@@ -15,6 +15,11 @@ struct ThreadPolicy {
   int cpu = -1;           // CPU to pin the thread to, [-1, 1023]; -1 = no affinity
   // key: the config prefix for messages, e.g. "threads.capture".
   Status validate(const std::string& key) const;
+  template <class Self, class V>
+  static void fields(Self& s, V& v) {
+    v("fifo_priority", s.fifo_priority);
+    v("cpu", s.cpu);
+  }
 };
 
 // mlockall(MCL_CURRENT | MCL_FUTURE).

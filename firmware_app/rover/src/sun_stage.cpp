@@ -1,0 +1,68 @@
+#include "stages.hpp"
+#include "sunvo/runtime/clock.hpp"
+#include "sunvo/sun/spa.hpp"
+
+namespace sunvo::rover {
+
+void SunStage::run() {
+  Channels& ch = ctx_.channels;
+  Health& health = ctx_.health;
+  sun::SpaOptions spa;
+  spa.latitude_deg = origin_.lat_deg;
+  spa.longitude_deg = origin_.lon_deg;
+  spa.elevation_m = origin_.alt_m;
+  for (;;) {
+    const std::uint32_t key = ch.sun_requests_ev.prepare();
+    SunRequest req;
+    if (!ch.sun_requests.pop(&req)) {
+      if (ch.stop.load(std::memory_order_acquire) ||
+          ch.estimator_done.load(std::memory_order_acquire)) {
+        break;
+      }
+      ch.sun_requests_ev.wait(key, 100'000'000);
+      continue;
+    }
+    ctx_.profiler.stamp(req.sequence, runtime::Stamp::kSunStart, runtime::monotonicNs());
+    SunResult res;
+    res.sequence = req.sequence;
+    res.utc_ns = req.utc_ns;
+    auto sp = sun::computeSolarPosition(req.utc_ns, spa);
+    SunQuery query;
+    query.sequence = req.sequence;
+    query.source_index = req.source_index;
+    query.utc_ns = req.utc_ns;
+    if (req.image_slot != kNoImage) query.images = &ctx_.sun_pool->slot(req.image_slot).frame;
+    Eigen::Quaterniond q_w_c_now;
+    if (sp && attitude_.latest(&q_w_c_now)) {
+      // Prior in the camera: sun_c = R_c_w sun_w, up_c = R_c_w (0, 0, 1) with ENU world (z up).
+      // The attitude is the last published pose's, one or a few frames before this one.
+      const Eigen::Matrix3d R_c_w = q_w_c_now.toRotationMatrix().transpose();
+      sunfusion::SunPrior prior;
+      prior.sun_c = (R_c_w * sp->sun_enu).normalized();
+      prior.up_c = R_c_w * Eigen::Vector3d::UnitZ();
+      query.prior = prior;
+    }
+    auto m = provider_->measure(query);
+    if (req.image_slot != kNoImage) ctx_.sun_pool->release(req.image_slot);
+    if (!sp || !m) {
+      health.sun_errors.fetch_add(1, std::memory_order_relaxed);
+    } else if (m->has_value()) {
+      const sunfusion::SunMeasurement& meas = **m;
+      res.has_measurement = meas.sun_c.allFinite();
+      res.azimuth_only = meas.kind == sunfusion::SunMeasurementKind::kAzimuthOnly;
+      res.sigma = meas.sigma;
+      for (int i = 0; i < 3; ++i) {
+        res.sun_c[i] = meas.sun_c[i];
+        res.sun_w[i] = sp->sun_enu[i];
+      }
+      if (res.has_measurement) health.sun_measurements.fetch_add(1, std::memory_order_relaxed);
+    }
+    ch.sun_results.push(res);
+    ch.sun_results_ev.notify();
+    ctx_.profiler.stamp(req.sequence, runtime::Stamp::kSunEnd, runtime::monotonicNs());
+    meter_.frameDone();
+  }
+  ch.sun_done.store(true, std::memory_order_release);
+}
+
+}  // namespace sunvo::rover
