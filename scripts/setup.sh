@@ -27,7 +27,21 @@ fi
 
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
-echo "setup: installing ${missing[*]}"
 export DEBIAN_FRONTEND=noninteractive
-$SUDO apt-get update -qq
-$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+# One line per step; the package manager's own output only when a step fails.
+log=$(mktemp)
+trap 'rm -f "$log"' EXIT
+step() {
+  local what=$1
+  shift
+  echo "setup: $what"
+  if ! "$@" >"$log" 2>&1; then
+    echo "setup: FAILED: $what ($*):" >&2
+    cat "$log" >&2
+    exit 1
+  fi
+}
+step "updating the package lists" $SUDO apt-get update -q
+step "installing ${#missing[@]} packages: ${missing[*]}" \
+  $SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"
+echo "setup: done"
