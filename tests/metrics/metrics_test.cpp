@@ -460,5 +460,41 @@ TEST(RealKitti00, Table1MatchesIndependentLongDoubleReference) {
   std::printf("largest relative difference to the long-double reference: %.3e\n", g_max_rel_diff);
 }
 
+// evo's RPE per 100 m on a synthetic estimate of the real KITTI 06 ground truth (a yaw drift of
+// 2e-5 rad per frame, 1 % scale, a 5 cm sideways wobble). The expected numbers were computed by
+// evo's own pair selection and error (filters.filter_pairs_by_path, metrics.RPE.rpe_base at evo
+// commits 02751b2 / 01c1dd5) run with numpy on the same input (hil/tools/eval/README.md, "evo").
+TEST(RpeEvo, MatchesEvoOnAKittiCase) {
+  auto gt = files::readKittiPoses(std::string(SUNVO_DATA_DIR) + "/kitti_odometry/06_gt_poses.txt");
+  ASSERT_TRUE(gt);
+  std::vector<Isometry3> est;
+  for (std::size_t k = 0; k < gt->size(); ++k) {
+    const Eigen::Matrix3d Ry = rotY(2e-5 * static_cast<double>(k));
+    est.push_back(pose(Ry * gt->T_w_c[k].linear(),
+                       1.01 * (Ry * gt->T_w_c[k].translation()) +
+                           Eigen::Vector3d(0.05 * std::sin(0.1 * static_cast<double>(k)), 0, 0)));
+  }
+  auto on_est = computeRpeEvo(gt->T_w_c, est, 100.0, RpePathOf::kEstimate);
+  ASSERT_TRUE(on_est) << on_est.status().toString();
+  EXPECT_EQ(on_est->translation_m.count, 11u);
+  EXPECT_NEAR(on_est->translation_m.rmse, 0.987240380371232, 1e-5);
+  EXPECT_NEAR(on_est->translation_m.mean, 0.972693396952079, 1e-5);
+  EXPECT_NEAR(on_est->translation_m.median, 0.9965973075055002, 1e-5);
+  EXPECT_NEAR(on_est->translation_m.max, 1.2321359342320595, 1e-5);
+  EXPECT_NEAR(on_est->rotation_rad.rmse, 0.0018026243495122914, 1e-8);
+  EXPECT_NEAR(on_est->rotation_rad.max, 0.0024800000000001084, 1e-8);
+  auto on_ref = computeRpeEvo(gt->T_w_c, est, 100.0, RpePathOf::kReference);
+  ASSERT_TRUE(on_ref);
+  EXPECT_EQ(on_ref->translation_m.count, 11u);
+  EXPECT_NEAR(on_ref->translation_m.rmse, 1.0007315253033464, 1e-5);
+  EXPECT_NEAR(on_ref->translation_m.median, 1.0029159733667843, 1e-5);
+  EXPECT_NEAR(on_ref->rotation_rad.rmse, 0.0018293168123646598, 1e-8);
+  // evo's consecutive pairs differ from the every-start pairs of computeRpePerDistance.
+  auto all_starts = computeRpePerDistance(gt->T_w_c, est, 100.0);
+  ASSERT_TRUE(all_starts);
+  EXPECT_GT(all_starts->translation_m.count, 900u);
+  EXPECT_FALSE(computeRpeEvo(gt->T_w_c, est, 0.0));
+}
+
 }  // namespace
 }  // namespace sunvo::metrics

@@ -319,6 +319,34 @@ Expected<RpeMetrics> computeRpePerDistance(const std::vector<Isometry3>& T_w_c_g
   return RpeMetrics{distance_m, summarize(std::move(e_t)), summarize(std::move(e_r))};
 }
 
+Expected<RpeMetricsEvo> computeRpeEvo(const std::vector<Isometry3>& T_w_c_gt,
+                                      const std::vector<Isometry3>& T_w_c_est, double delta_m,
+                                      RpePathOf path_of) {
+  if (!(delta_m > 0.0) || !std::isfinite(delta_m)) {
+    return invalidArgument("rpe delta_m: must be finite and > 0 m");
+  }
+  SUNVO_RETURN_IF_ERROR(validateTrajectories(T_w_c_gt, T_w_c_est));
+  const std::vector<Isometry3>& path = path_of == RpePathOf::kEstimate ? T_w_c_est : T_w_c_gt;
+  std::vector<std::size_t> chosen;
+  double since_last = 0.0;
+  for (std::size_t k = 1; k < path.size(); ++k) {
+    since_last += (path[k].translation() - path[k - 1].translation()).norm();
+    if (since_last >= delta_m) {
+      chosen.push_back(k);
+      since_last = 0.0;
+    }
+  }
+  std::vector<double> e_t;
+  std::vector<double> e_r;
+  for (std::size_t n = 1; n < chosen.size(); ++n) {
+    const std::size_t i = chosen[n - 1], j = chosen[n];
+    const PairError e = relativeError(T_w_c_gt[i], T_w_c_gt[j], T_w_c_est[i], T_w_c_est[j]);
+    e_t.push_back(e.translation_m);
+    e_r.push_back(e.angle_rad);
+  }
+  return RpeMetricsEvo{delta_m, path_of, summarize(std::move(e_t)), summarize(std::move(e_r))};
+}
+
 Status EvaluationOptions::validate() const {
   SUNVO_RETURN_IF_ERROR(kitti.validate());
   if (!(rpe_distance_m > 0.0) || !std::isfinite(rpe_distance_m)) {
@@ -376,6 +404,9 @@ Expected<Evaluation> evaluate(const std::vector<Isometry3>& T_w_c_gt,
   auto rpe_dist = computeRpePerDistance(T_w_c_gt, T_w_c_est, options.rpe_distance_m);
   if (!rpe_dist) return rpe_dist.status();
   ev.rpe_distance = *rpe_dist;
+  auto rpe_evo = computeRpeEvo(T_w_c_gt, T_w_c_est, options.rpe_distance_m);
+  if (!rpe_evo) return rpe_evo.status();
+  ev.rpe_evo = *rpe_evo;
   return ev;
 }
 

@@ -147,6 +147,10 @@ std::string extraMetricsMarkdown(const ReportInput& input) {
        [](const auto& e) { return e.rpe_distance.translation_m.rmse; }, 3},
       {"RPE/" + d + " m rot. RMSE [deg]",
        [](const auto& e) { return e.rpe_distance.rotation_rad.rmse * kRadToDeg; }, 3},
+      {"RPE/" + d + " m (evo pairs) trans. RMSE [m]",
+       [](const auto& e) { return e.rpe_evo.translation_m.rmse; }, 3},
+      {"RPE/" + d + " m (evo pairs) rot. RMSE [deg]",
+       [](const auto& e) { return e.rpe_evo.rotation_rad.rmse * kRadToDeg; }, 3},
   };
   return markdownTable(input, "Metric", rows, false);
 }
@@ -223,6 +227,15 @@ std::string evaluationJson(const ReportInput& input) {
     writeRpe(w, ev.rpe_frame);
     w.key("rpe_per_distance");
     writeRpe(w, ev.rpe_distance);
+    // evo_rpe --delta D --delta_unit m (consecutive pairs on the estimate's path).
+    w.key("rpe_evo").beginObject();
+    w.key("delta_m").value(ev.rpe_evo.delta_m);
+    w.key("pairs").value("consecutive, path of the estimate (evo's default)");
+    w.key("translation_m");
+    writeStats(w, ev.rpe_evo.translation_m, 1.0);
+    w.key("rotation_deg");
+    writeStats(w, ev.rpe_evo.rotation_rad, kRadToDeg);
+    w.endObject();
     w.endObject();
   }
   w.endArray();

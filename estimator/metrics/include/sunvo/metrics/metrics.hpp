@@ -153,6 +153,23 @@ struct RpeMetrics {
   ErrorStats rotation_rad;
 };
 
+// The same relative error with the pairs that evo chooses (evo_rpe --delta D --delta_unit m,
+// consecutive pairs, metrics.RPE + filters.filter_pairs_by_path): walking the trajectory from
+// frame 0 and summing the straight-line steps |p_k - p_k-1|, every frame where the sum since the
+// last chosen frame first reaches D is chosen (frame 0 is not, unless D <= 0); pairs are
+// consecutive chosen frames (i, j). evo measures the path on the estimate by default and on the
+// reference with --pairs_from_reference. tests/metrics checks it against evo's own code.
+enum class RpePathOf { kEstimate, kReference };
+struct RpeMetricsEvo {
+  double delta_m = 0.0;
+  RpePathOf path_of = RpePathOf::kEstimate;
+  ErrorStats translation_m;  // |translation(E_ij)| (evo: -r trans_part)
+  ErrorStats rotation_rad;   // rotationAngle(E_ij) (evo: -r angle_rad)
+};
+Expected<RpeMetricsEvo> computeRpeEvo(const std::vector<Isometry3>& T_w_c_gt,
+                                      const std::vector<Isometry3>& T_w_c_est, double delta_m,
+                                      RpePathOf path_of = RpePathOf::kEstimate);
+
 // Everything above for one estimate.
 struct EvaluationOptions {
   HorizontalPlane plane = HorizontalPlane::kCameraXZ;  // plane of Table 1's in-plane rows
@@ -168,6 +185,7 @@ struct Evaluation {
   ApeMetrics ape_se3;
   RpeMetrics rpe_frame;
   RpeMetrics rpe_distance;
+  RpeMetricsEvo rpe_evo;  // evo's definition, rpe_distance_m, path of the estimate
 };
 
 // Checks the common input contract (same length >= 2, all finite); names the first bad pose.
