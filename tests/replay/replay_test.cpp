@@ -78,6 +78,43 @@ TEST(Replay, RenderedDriveThroughTheWholeChain) {
       "rad\n",
       ev->table1.final_drift_m, ev_sun->table1.final_drift_m, ev->table1.rot_armse_rad,
       ev_sun->table1.rot_armse_rad);
+
+  // The same drive as a plain KITTI raw drive (images, OXTS, calibration; no gt/ folder): the
+  // ground truth comes from the OXTS records, the true sun from the ephemeris once the
+  // recording's offset to UTC is stated.
+  const auto raw_day = std::filesystem::path(SUNVO_BINARY_DIR) / "test_render_cache" / "raw_20";
+  std::filesystem::remove_all(raw_day);
+  const std::filesystem::path drive_path(*drive);
+  const auto raw_drive = raw_day / drive_path.parent_path().filename() / drive_path.filename();
+  std::filesystem::create_directories(raw_drive.parent_path());
+  std::filesystem::copy(
+      drive_path.parent_path(), raw_drive.parent_path(),
+      std::filesystem::copy_options::recursive | std::filesystem::copy_options::overwrite_existing);
+  std::filesystem::remove_all(raw_drive / "gt");
+  ReplayOptions raw_options;
+  raw_options.dataset.path = raw_drive.string();
+  auto raw = openReplayDataset(raw_options);
+  ASSERT_TRUE(raw) << raw.status().toString();
+  EXPECT_EQ(raw->kind(), dataset::DatasetKind::kKittiRaw);
+  EXPECT_FALSE(raw->sunKnown());  // no zone stated: pure VO only
+  EXPECT_FALSE(replayDrive(*raw, raw_options, sources[0]));
+  auto raw_pure = replayDrive(*raw, raw_options, std::nullopt);
+  ASSERT_TRUE(raw_pure) << raw_pure.status().toString();
+  EXPECT_EQ(raw_pure->T_w_c.back().matrix(), pure->T_w_c.back().matrix());
+  auto ev_raw = metrics::evaluate(raw->groundTruth(), raw_pure->T_w_c, eval);
+  ASSERT_TRUE(ev_raw);
+  // OXTS ground truth against the renderer's: the same drive to the OXTS files' precision.
+  EXPECT_NEAR(ev_raw->table1.final_drift_m, ev->table1.final_drift_m, 1e-3);
+  raw_options.dataset.utc_offset_s = 0;  // the renderer writes UTC
+  auto raw_sun = openReplayDataset(raw_options);
+  ASSERT_TRUE(raw_sun && raw_sun->sunKnown());
+  for (std::size_t k = 0; k < raw_sun->size(); ++k) {
+    EXPECT_LT((raw_sun->trueSun()[k].sun_c - data->trueSun()[k].sun_c).norm(), 1e-3) << k;
+  }
+  auto raw_true = replayDrive(*raw_sun, raw_options, sources[0]);
+  ASSERT_TRUE(raw_true) << raw_true.status().toString();
+  EXPECT_EQ(raw_true->gate.accepted, 3u);
+  std::filesystem::remove_all(raw_day);
 }
 
 TEST(Replay, MissingDriveIsAClearError) {
