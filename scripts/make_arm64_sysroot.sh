@@ -60,8 +60,17 @@ fi
 # Architecture: all packages (headers such as Eigen, data) or the host's copy of a Multi-Arch:
 # foreign package (whose arm64 copy is in the list too); only the former are kept. Virtual
 # packages ("<name>") are dropped.
+# An Architecture: all package (CLI11, Eigen: headers only) has no ":arm64" name; asked for as one,
+# apt-cache lists it as a missing virtual package and the closure silently lacks it.
 targets=()
-for p in "${DEV_PACKAGES[@]}"; do targets+=("${p}:arm64"); done
+for p in "${DEV_PACKAGES[@]}"; do
+  # (The listing is read whole: grep -q would exit early and fail the pipe under pipefail.)
+  if grep -qx 'Architecture: all' <<<"$(apt-cache show --no-all-versions "${p}")"; then
+    targets+=("${p}")
+  else
+    targets+=("${p}:arm64")
+  fi
+done
 closure="$(apt-cache depends --recurse --no-recommends --no-suggests --no-conflicts --no-breaks \
   --no-replaces --no-enhances "${targets[@]}" | grep -E '^[a-z0-9]' | sort -u)"
 arm64_pkgs=$(grep -E ':arm64$' <<<"${closure}" || true)
