@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "sunvo/dataset/track_folder.hpp"
 #include "sunvo/files/tracks_io.hpp"
 #include "sunvo/files/trajectory_io.hpp"
 #include "sunvo/vo/stereo_odometry.hpp"
@@ -126,11 +127,15 @@ int main(int argc, char** argv) {
       opt.window.loss_scale, opt.window.max_num_iterations, opt.window.max_solver_time_in_seconds,
       opt.ransac.min_disparity_px, opt.window.motion_prior_sigma_rot_deg,
       opt.window.motion_prior_sigma_trans_m, static_cast<unsigned long long>(opt.seed));
-  auto seq = sunvo::files::readTrackFolder(folder, sunvo::files::TrackReadOptions{});
+  auto seq = sunvo::dataset::readTrackFolder(folder, sunvo::files::TrackReadOptions{});
   if (!seq) {
     std::fprintf(stderr, "sunvo_track_vo: %s\n", seq.status().toString().c_str());
     return 1;
   }
+  std::printf(
+      "tracks: image %dx%d from %s; %zu observations dropped past the border (max %.3f px)\n",
+      seq->camera.width, seq->camera.height, seq->image_size_source.c_str(),
+      seq->dropped_past_border, seq->max_outside_px);
   std::size_t n = seq->frames.size();
   if (max_frames > 0) n = std::min(n, static_cast<std::size_t>(max_frames));
 

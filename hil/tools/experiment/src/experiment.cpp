@@ -151,6 +151,7 @@ Expected<Route> loadRoute(const std::string& spec, const std::string& data_dir,
     return notFound(dopt.path + ": the experiment needs the true sun: " + ds->sunUnknownReason());
   }
   Route route;
+  route.source = ds->describe();
   route.camera = ds->camera();
   route.T_w_c_gt = ds->groundTruth();
   route.times_ns = ds->timesNs();

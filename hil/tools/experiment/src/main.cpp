@@ -137,7 +137,8 @@ int main(int argc, char** argv) {
     sunvo::Expected<Route> route = sunvo::experiment::loadRoute(route_spec, data_dir, sim);
     if (!route)
       return sunvo::cli::fail(kProgram, "route " + route_spec + ": " + route.status().toString());
-    std::fprintf(stderr, "route %s: %zu frames\n", route->name.c_str(), route->frames.size());
+    std::fprintf(stderr, "route %s: %zu frames; %s\n", route->name.c_str(), route->frames.size(),
+                 route->source.c_str());
     std::vector<RunResult> runs;
     for (std::size_t s = 0; s <= sources.size(); ++s) {
       std::optional<sunvo::experiment::SunSourceSpec> spec;

@@ -28,7 +28,8 @@
 namespace sunvo::experiment {
 
 struct Route {
-  std::string name;  // e.g. "2011_09_30_drive_0020 (real tracks)"
+  std::string name;    // e.g. "2011_09_30_drive_0020 (real tracks)"
+  std::string source;  // Dataset::describe() of the data it came from (image size, drops)
   StereoCamera camera;
   std::vector<FrameFeatures> frames;
   std::vector<TimeNs> times_ns;           // frame times (UTC ns when known, else relative)
