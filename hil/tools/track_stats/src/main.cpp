@@ -167,12 +167,17 @@ int main(int argc, char** argv) {
 
   if (!estimate.empty()) {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero(), sum_jumps = Eigen::Vector3d::Zero();
+    Eigen::Vector3d sum_one = Eigen::Vector3d::Zero(), sum_bal = Eigen::Vector3d::Zero();
+    std::vector<double> abs_one, abs_bal;
     std::vector<double> rot;
     for (std::size_t k = 1; k < stats->frames.size(); ++k) {
       const FrameStats& f = stats->frames[k];
       sum += f.rot_err_c_mdeg;
       rot.push_back(f.rot_err_mdeg);
       if (f.rot_err_mdeg > opt.jump_rotation_mdeg) sum_jumps += f.rot_err_c_mdeg;
+      const bool one = f.tracks > 0 && (f.left_share < 0.15 || f.left_share > 0.85);
+      (one ? sum_one : sum_bal) += f.rot_err_c_mdeg;
+      (one ? abs_one : abs_bal).push_back(f.rot_err_mdeg);
     }
     std::printf("\nestimate %s: per-frame rotation error\n", estimate_path.c_str());
     printDistribution("|rotation error|", rot, 1.0, "mdeg");
@@ -181,6 +186,12 @@ int main(int argc, char** argv) {
         "frames over %.0f mdeg: %+.1f %+.1f %+.1f deg\n",
         sum.x() * 1e-3, sum.y() * 1e-3, sum.z() * 1e-3, opt.jump_rotation_mdeg,
         sum_jumps.x() * 1e-3, sum_jumps.y() * 1e-3, sum_jumps.z() * 1e-3);
+    std::printf(
+        "  one-sided frames (%zu): summed %+.1f %+.1f %+.1f deg, median |error| %.1f mdeg; "
+        "the others (%zu): %+.1f %+.1f %+.1f deg, median %.1f mdeg\n",
+        abs_one.size(), sum_one.x() * 1e-3, sum_one.y() * 1e-3, sum_one.z() * 1e-3,
+        quantile(abs_one, 0.5), abs_bal.size(), sum_bal.x() * 1e-3, sum_bal.y() * 1e-3,
+        sum_bal.z() * 1e-3, quantile(abs_bal, 0.5));
   }
   std::printf(
       "\njumps: %zu (residual: mean du or dv more than %.1f robust sigmas from the "
