@@ -55,6 +55,12 @@ TEST(TrackStats, CleanTracksHaveNoErrorAnywhere) {
   EXPECT_GT(s->mono_landmarks, 50u);
   for (const DepthBin& b : s->depth_bins) EXPECT_NEAR(b.mean_px, 0.0, 1e-5) << b.z_min_m;
   EXPECT_NEAR(s->flow.gain, 0.0, 1e-9);
+  std::size_t pairs = 0;
+  for (const ResidualDepthBin& b : s->residual_depths) {
+    pairs += b.n;
+    EXPECT_NEAR(b.mean_dv, 0.0, 1e-6) << b.z_min_m;
+  }
+  EXPECT_GT(pairs, 500u);
   EXPECT_TRUE(s->jumps.empty());
 }
 

@@ -56,6 +56,8 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.01, 89.0));
   app.add_option("--jump-sigmas", opt.jump_sigmas, "robust sigmas of a residual jump")
       ->check(CLI::Range(0.1, 100.0));
+  app.add_option("--jump-min-px", opt.jump_min_px, "and at least this far from the median, px")
+      ->check(CLI::Range(0.0, 100.0));
   app.add_option("--jump-rotation-mdeg", opt.jump_rotation_mdeg,
                  "per-frame rotation error of a jump, mdeg")
       ->check(CLI::Range(0.001, 1e6));
@@ -155,6 +157,11 @@ int main(int argc, char** argv) {
                 std::min(b.z_max_m, 999.0), b.n, b.mean_px, b.median_px);
   }
 
+  std::printf("\nmotion residual by stereo depth in k-1:\n");
+  for (const auto& b : stats->residual_depths) {
+    std::printf("  z [%3.0f, %3.0f) m: %6zu pairs  du %+.4f  dv %+.4f px\n", b.z_min_m,
+                std::min(b.z_max_m, 999.0), b.n, b.mean_du, b.mean_dv);
+  }
   std::printf("\nby track age (frames since the track's first observation):\n");
   for (const auto& a : stats->ages) {
     std::printf("  age %3d-%-7d %6zu pairs  du %+.4f  dv %+.4f px   %6zu obs  vL - vR %+.4f px\n",

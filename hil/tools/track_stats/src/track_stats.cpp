@@ -210,6 +210,9 @@ Expected<TrackStats> computeTrackStats(const StereoCamera& cam,
     while (i + 1 < kAges && static_cast<int>(age) >= kAgeEdges[i + 1]) ++i;
     return i;
   };
+  static constexpr double kZEdges[] = {0, 5, 10, 15, 20, 30, 40, 60, 1e9};
+  constexpr std::size_t kZ = std::size(kZEdges) - 1;
+  std::vector<double> z_du[kZ], z_dv[kZ];
   Eigen::Matrix3d flow_A = Eigen::Matrix3d::Zero();
   Eigen::Vector3d flow_b = Eigen::Vector3d::Zero();
   for (std::size_t k = 0; k < frames.size(); ++k) {
@@ -254,6 +257,13 @@ Expected<TrackStats> computeTrackStats(const StereoCamera& cam,
         if (std::abs(eu) > opt.max_residual_px || std::abs(ev) > opt.max_residual_px) continue;
         du.push_back(eu);
         dv.push_back(ev);
+        const double z_km1 = cam.fu * cam.baseline_m / q.disparity();
+        for (std::size_t i = 0; i < kZ; ++i) {
+          if (z_km1 >= kZEdges[i] && z_km1 < kZEdges[i + 1]) {
+            z_du[i].push_back(eu);
+            z_dv[i].push_back(ev);
+          }
+        }
         const std::size_t bin = ageBin(k - first_seen[o.landmark_id]);
         age_du[bin].push_back(eu);
         age_dv[bin].push_back(ev);
@@ -291,6 +301,10 @@ Expected<TrackStats> computeTrackStats(const StereoCamera& cam,
     a.n_offset = age_off[i].size();
     a.mean_offset = mean(age_off[i]);
     out.ages.push_back(a);
+  }
+  for (std::size_t i = 0; i < kZ; ++i) {
+    out.residual_depths.push_back(
+        {kZEdges[i], kZEdges[i + 1], z_du[i].size(), mean(z_du[i]), mean(z_dv[i])});
   }
   if (out.flow.n > 0) {
     const Eigen::Vector3d x = flow_A.ldlt().solve(flow_b);

@@ -118,6 +118,15 @@ struct FlowFit {
   std::size_t n = 0;
 };
 
+// Motion residuals of the pairs whose stereo depth in k-1 is in [z_min_m, z_max_m): a rotation
+// error shifts every depth alike; a translation-direction or principal-point error shifts near
+// points more (~ 1/z).
+struct ResidualDepthBin {
+  double z_min_m = 0.0, z_max_m = 0.0;
+  std::size_t n = 0;
+  double mean_du = 0.0, mean_dv = 0.0;  // px
+};
+
 struct Jump {
   int frame = 0;
   bool residual = false;  // the mean motion residual jumps
@@ -131,6 +140,7 @@ struct TrackStats {
   std::vector<DepthBin> depth_bins;
   std::size_t mono_landmarks = 0;  // landmarks the disparity check could use
   std::vector<AgeBin> ages;
+  std::vector<ResidualDepthBin> residual_depths;
   FlowFit flow;
   std::vector<Jump> jumps;
 };
