@@ -118,13 +118,14 @@ TEST(StereoSelfCalibration, DivergenceIsResetAndCountedNeverNaN) {
 }
 
 TEST(StereoSelfCalibration, OffPassesThroughAndOptionsAreChecked) {
-  const auto frames = tracks(5, 0.3);
+  const auto frames = tracks(30, 0.3);
   StereoSelfCalibration cal;
   ASSERT_TRUE(cal.init(StereoSelfCalibrationOptions{}, camera()).isOk());
   FrameFeatures out;
   const auto r = cal.process(frames[2], &out);
   EXPECT_FALSE(r.updated);
-  EXPECT_EQ(out.observations.size(), frames[2].observations.size());
+  ASSERT_EQ(out.observations.size(), frames[2].observations.size());
+  ASSERT_FALSE(out.observations.empty());
   EXPECT_DOUBLE_EQ(out.observations[0].v_right, frames[2].observations[0].v_right);
   StereoSelfCalibrationOptions bad = on();
   bad.gate_px = 0.0;
