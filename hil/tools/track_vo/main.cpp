@@ -6,7 +6,7 @@
 //          [--sigma-uv px] [--sigma-d px] [--loss none|huber|cauchy] [--loss-scale s]
 //          [--ransac-thr px] [--ransac-iters n] [--min-inliers n] [--max-iters n]
 //          [--max-time s] [--min-disparity px] [--seed n] [--prior-rot-deg s] [--prior-trans-m s]
-//          [--log per_frame.csv]
+//          [--log per_frame.csv] [--self-calib] [--self-calib-log per_frame.csv]
 
 #include <algorithm>
 #include <chrono>
@@ -19,6 +19,7 @@
 #include "sunvo/dataset/track_folder.hpp"
 #include "sunvo/files/tracks_io.hpp"
 #include "sunvo/files/trajectory_io.hpp"
+#include "sunvo/selfcal/stereo_self_calibration.hpp"
 #include "sunvo/vo/stereo_odometry.hpp"
 
 namespace {
@@ -42,7 +43,8 @@ int usage(const char* msg) {
                "[--no-window] [--sigma-uv px] [--sigma-d px] [--loss none|huber|cauchy] "
                "[--loss-scale s] [--ransac-thr px] [--ransac-iters n] [--min-inliers n] "
                "[--max-iters n] [--max-time s] [--min-disparity px] [--seed n] [--prior-rot-deg s] "
-               "[--prior-trans-m s] [--log per_frame.csv]\n");
+               "[--prior-trans-m s] [--log per_frame.csv] [--self-calib] "
+               "[--self-calib-log per_frame.csv]\n");
   return 2;
 }
 
@@ -55,6 +57,8 @@ int main(int argc, char** argv) {
   sunvo::vo::VoOptions opt;
   long max_frames = -1;
   std::string log_path;
+  sunvo::selfcal::StereoSelfCalibrationOptions selfcal_opt;  // issue 15: off unless --self-calib
+  std::string selfcal_log_path;
   for (int i = 3; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&](double& v) {
@@ -67,6 +71,11 @@ int main(int argc, char** argv) {
     if (a == "--log") {
       if (i + 1 >= argc) return usage("--log needs a path");
       log_path = argv[++i];
+    } else if (a == "--self-calib") {
+      selfcal_opt.enabled = true;
+    } else if (a == "--self-calib-log") {
+      if (i + 1 >= argc) return usage("--self-calib-log needs a path");
+      selfcal_log_path = argv[++i];
     } else if (a == "--no-window") {
       opt.use_window = false;
     } else if (a == "--loss") {
@@ -144,6 +153,16 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "sunvo_track_vo: %s\n", s.toString().c_str());
     return 1;
   }
+  sunvo::selfcal::StereoSelfCalibration selfcal;
+  if (auto s = selfcal.init(selfcal_opt, seq->camera); !s.isOk())
+    return usage(s.toString().c_str());
+  sunvo::FrameFeatures corrected;
+  std::FILE* selfcal_log =
+      selfcal_log_path.empty() ? nullptr : std::fopen(selfcal_log_path.c_str(), "w");
+  if (selfcal_log != nullptr) {
+    std::fprintf(selfcal_log, "frame,pitch_mrad,roll_mrad,scale,roll_sigma_mrad,used,reset\n");
+  }
+  std::vector<double> selfcal_ms;
   std::vector<Isometry3> poses;
   poses.reserve(n);
   std::FILE* log = log_path.empty() ? nullptr : std::fopen(log_path.c_str(), "w");
@@ -157,7 +176,18 @@ int main(int argc, char** argv) {
   long iterations = 0;
   for (std::size_t k = 0; k < n; ++k) {
     const auto t0 = std::chrono::steady_clock::now();
-    auto r = vo.process(seq->frames[k]);
+    const sunvo::FrameFeatures* frame = &seq->frames[k];
+    if (selfcal.enabled()) {
+      const auto rep = selfcal.process(*frame, &corrected);
+      frame = &corrected;
+      selfcal_ms.push_back(
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+      if (selfcal_log != nullptr) {
+        std::fprintf(selfcal_log, "%zu,%.5f,%.5f,%.7f,%.5f,%d,%d\n", k, rep.pitch_mrad,
+                     rep.roll_mrad, rep.scale, rep.roll_sigma_mrad, rep.used, rep.reset ? 1 : 0);
+      }
+    }
+    auto r = vo.process(*frame);
     const double ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     if (!r) {
@@ -183,6 +213,14 @@ int main(int argc, char** argv) {
     iterations += r->solver_iterations;
   }
   if (log != nullptr) std::fclose(log);
+  if (selfcal_log != nullptr) std::fclose(selfcal_log);
+  if (selfcal.enabled()) {
+    std::printf(
+        "self-calibration: right camera pitch %.4f mrad, roll %.4f mrad, vertical scale "
+        "%.6f at the end; %llu resets; %.4f ms/frame median\n",
+        selfcal.state()[0] * 1e3, selfcal.state()[1] * 1e3, selfcal.state()[2],
+        static_cast<unsigned long long>(selfcal.resets()), percentile(selfcal_ms, 50));
+  }
   sunvo::files::Trajectory out_traj;
   out_traj.T_w_c = poses;
   for (std::size_t k = 0; k < poses.size(); ++k) out_traj.t_ns.push_back(seq->frames[k].time_ns);
