@@ -101,7 +101,7 @@ TEST_F(SunAidedOdometryTest, PureVoIsTheBackEndAlone) {
   options_.use_sun = false;
   SunAidedOdometry pure;
   run(&pure);
-  vo::StereoOdometry back;
+  vo::StereoTrackOdometry back;
   ASSERT_TRUE(back.init(options_.pipeline.vo, camera_, T_w_c0_).isOk());
   for (int k = 0; k < kFrames; ++k) {
     auto r = back.process(frames_[static_cast<std::size_t>(k)]);

@@ -38,7 +38,7 @@ inline std::int64_t nowNs() {
 }
 
 inline Status badKey(const char* key, const std::string& what) {
-  return invalidArgument(std::string("frontend option '") + key + "': " + what);
+  return invalidArgument(std::string("frontend.") + key + ": " + what);
 }
 
 // Sum of absolute differences of two 32-byte descriptors.

@@ -6,7 +6,7 @@ Status SunAidedOptions::validate() const {
   SUNVO_RETURN_IF_ERROR(pipeline.validate());
   SUNVO_RETURN_IF_ERROR(fusion.validate());
   if (every_n_frames < 1 || every_n_frames > 1000) {
-    return invalidArgument("sun_aided.every_n_frames: " + std::to_string(every_n_frames) +
+    return invalidArgument("every_n_frames: " + std::to_string(every_n_frames) +
                            " is outside [1, 1000]");
   }
   return Status::ok();

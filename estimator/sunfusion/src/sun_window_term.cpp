@@ -56,42 +56,42 @@ double chiSquareQuantile(double p, int dof) {
 Status SunFusionOptions::validate() const {
   SUNVO_RETURN_IF_ERROR(gate.validate());
   if (!world_up.allFinite() || std::abs(world_up.norm() - 1.0) > 1e-6) {
-    return invalidArgument("sun_fusion.world_up must be a unit vector");
+    return invalidArgument("fusion.world_up must be a unit vector");
   }
   if (!(loss_scale >= 0.0 && loss_scale <= 100.0)) {
-    return invalidArgument("sun_fusion.loss_scale out of range [0, 100]");
+    return invalidArgument("fusion.loss_scale out of range [0, 100]");
   }
   if (!(initial_attitude_sigma_deg > 0.0 && initial_attitude_sigma_deg <= 45.0)) {
-    return invalidArgument("sun_fusion.initial_attitude_sigma_deg out of range (0, 45]");
+    return invalidArgument("fusion.initial_attitude_sigma_deg out of range (0, 45]");
   }
   if (!(attitude_drift_deg_per_frame >= 0.0 && attitude_drift_deg_per_frame <= 5.0)) {
-    return invalidArgument("sun_fusion.attitude_drift_deg_per_frame out of range [0, 5]");
+    return invalidArgument("fusion.attitude_drift_deg_per_frame out of range [0, 5]");
   }
   if (!(min_drift_deg_per_frame >= 0.0 && min_drift_deg_per_frame <= max_drift_deg_per_frame &&
         max_drift_deg_per_frame <= 5.0)) {
     return invalidArgument(
-        "sun_fusion.min_drift_deg_per_frame / max_drift_deg_per_frame: need 0 <= min <= max <= 5");
+        "fusion.min_drift_deg_per_frame / max_drift_deg_per_frame: need 0 <= min <= max <= 5");
   }
   if (!(drift_adaptation_rate > 0.0 && drift_adaptation_rate <= 1.0)) {
-    return invalidArgument("sun_fusion.drift_adaptation_rate out of range (0, 1]");
+    return invalidArgument("fusion.drift_adaptation_rate out of range (0, 1]");
   }
   if (!(persistence_forgetting > 0.0 && persistence_forgetting < 1.0)) {
-    return invalidArgument("sun_fusion.persistence_forgetting out of range (0, 1)");
+    return invalidArgument("fusion.persistence_forgetting out of range (0, 1)");
   }
   if (!(persistence_false_alarm > 0.0 && persistence_false_alarm <= 0.5)) {
-    return invalidArgument("sun_fusion.persistence_false_alarm out of range (0, 0.5]");
+    return invalidArgument("fusion.persistence_false_alarm out of range (0, 0.5]");
   }
   if (!(persistence_step_up > 0.0 && persistence_step_up <= 2.0)) {
-    return invalidArgument("sun_fusion.persistence_step_up out of range (0, 2]");
+    return invalidArgument("fusion.persistence_step_up out of range (0, 2]");
   }
   if (!(persistence_step_down > 0.0 && persistence_step_down <= 2.0)) {
-    return invalidArgument("sun_fusion.persistence_step_down out of range (0, 2]");
+    return invalidArgument("fusion.persistence_step_down out of range (0, 2]");
   }
   if (!(persistence_huber > 0.0 && persistence_huber <= 100.0)) {
-    return invalidArgument("sun_fusion.persistence_huber out of range (0, 100]");
+    return invalidArgument("fusion.persistence_huber out of range (0, 100]");
   }
   if (!(innovation_gate_chi2 >= 0.0 && innovation_gate_chi2 <= 1e6)) {
-    return invalidArgument("sun_fusion.innovation_gate_chi2 out of range [0, 1e6]");
+    return invalidArgument("fusion.innovation_gate_chi2 out of range [0, 1e6]");
   }
   return Status::ok();
 }

@@ -298,7 +298,7 @@ Status RoverConfig::validate() const {
   }
   // The estimator's own ranges, named by its keys.
   if (const Status e = estimator.validate(); !e.isOk()) {
-    return Status(e.code(), "estimator: " + e.message());
+    return Status(e.code(), "estimator." + e.message());
   }
   if (estimator.pipeline.frontend.max_features > 2000) {
     return outside("estimator.frontend.max_features", estimator.pipeline.frontend.max_features,

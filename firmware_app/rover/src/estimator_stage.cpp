@@ -18,7 +18,7 @@ Status EstimatorStage::init(const StereoCamera& camera, const Isometry3& T_w_c0,
   options.pipeline.frontend.max_height =
       std::max(options.pipeline.frontend.max_height, c.frames.height);
   const Status s = odometry_.init(options, camera, T_w_c0);
-  if (!s.isOk()) return Status(s.code(), c.path + ": estimator: " + s.message());
+  if (!s.isOk()) return Status(s.code(), c.path + ": estimator." + s.message());
   meter_.setWarmup(static_cast<std::uint64_t>(c.realtime.warmup_frames));
   return Status::ok();
 }

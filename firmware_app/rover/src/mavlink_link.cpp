@@ -5,7 +5,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "sunvo/vo/stereo_odometry.hpp"
+#include "sunvo/vo/stereo_track_odometry.hpp"
 
 namespace sunvo::rover {
 

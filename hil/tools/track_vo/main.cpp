@@ -1,26 +1,21 @@
-// sunvo_track_vo: runs StereoOdometry over a feature-track folder (tracks.csv, calib.txt,
-// times.txt, optional gt_poses.txt), writes the estimated camera poses relative to frame 0 as a
-// KITTI pose file, and prints timing and a minimal accuracy summary against gt_poses.txt.
-//
-// Usage: sunvo_track_vo <track_folder> <out_poses.txt> [--frames N] [--window N] [--no-window]
-//          [--sigma-uv px] [--sigma-d px] [--loss none|huber|cauchy] [--loss-scale s]
-//          [--ransac-thr px] [--ransac-iters n] [--min-inliers n] [--max-iters n]
-//          [--max-time s] [--min-disparity px] [--seed n] [--prior-rot-deg s] [--prior-trans-m s]
-//          [--log per_frame.csv] [--self-calib] [--self-calib-log per_frame.csv]
+// sunvo_track_vo: pure VO (pipeline::SunAidedOdometry with the sun off, feature input) over a
+// feature-track folder (tracks.csv, calib.txt, times.txt, optional gt_poses.txt). Writes the
+// camera poses relative to frame 0 as KITTI and TUM pose files, and prints timing and a minimal
+// accuracy summary against gt_poses.txt. Options: sunvo_track_vo --help.
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <string>
 #include <vector>
 
+#include "sunvo/cli/cli.hpp"
 #include "sunvo/dataset/track_folder.hpp"
 #include "sunvo/files/tracks_io.hpp"
 #include "sunvo/files/trajectory_io.hpp"
+#include "sunvo/pipeline/sun_aided_odometry.hpp"
 #include "sunvo/selfcal/stereo_self_calibration.hpp"
-#include "sunvo/vo/stereo_odometry.hpp"
 
 namespace {
 
@@ -36,136 +31,114 @@ double percentile(std::vector<double> v, double p) {
   return v[lo] * (1.0 - f) + v[hi] * f;
 }
 
-int usage(const char* msg) {
-  std::fprintf(stderr, "sunvo_track_vo: %s\n", msg);
-  std::fprintf(stderr,
-               "usage: sunvo_track_vo <track_folder> <out_poses.txt> [--frames N] [--window N] "
-               "[--no-window] [--sigma-uv px] [--sigma-d px] [--loss none|huber|cauchy] "
-               "[--loss-scale s] [--ransac-thr px] [--ransac-iters n] [--min-inliers n] "
-               "[--max-iters n] [--max-time s] [--min-disparity px] [--seed n] [--prior-rot-deg s] "
-               "[--prior-trans-m s] [--log per_frame.csv] [--self-calib] "
-               "[--self-calib-log per_frame.csv]\n");
-  return 2;
-}
+struct Args {
+  std::string folder, out_path, log_path, selfcal_log_path;
+  long max_frames = -1;
+};
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc < 3) return usage("missing arguments");
-  const std::string folder = argv[1];
-  const std::string out_path = argv[2];
-  sunvo::vo::VoOptions opt;
-  long max_frames = -1;
-  std::string log_path;
+  constexpr const char* kProgram = "sunvo_track_vo";
+  Args args;
+  sunvo::pipeline::SunAidedOptions options;
+  options.use_sun = false;
+  sunvo::vo::VoOptions& opt = options.pipeline.vo;
+  sunvo::backend::WindowOptions& win = opt.window;
+  CLI::App app{"Pure stereo VO over a feature-track folder; KITTI and TUM poses out.", kProgram};
+  app.add_option("track_folder", args.folder, "tracks.csv, calib.txt, times.txt[, gt_poses.txt]")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  app.add_option("out_poses", args.out_path, "KITTI pose file to write (TUM next to it: _tum.txt)")
+      ->required();
+  app.add_option("--frames", args.max_frames, "first N frames (default: all)")
+      ->check(CLI::Range(1L, 100000000L));
+  app.add_option("--window", win.window_size, "window poses")->check(CLI::Range(2, 8));
+  app.add_flag("!--no-window", opt.use_window, "RANSAC motion only (no Ceres refinement)");
+  double sigma_uv = win.sigma_u_px;
+  app.add_option("--sigma-uv", sigma_uv, "pixel noise of u and v, px")->check(CLI::PositiveNumber);
+  app.add_option("--sigma-d", win.sigma_d_px, "disparity noise, px")->check(CLI::PositiveNumber);
+  std::string loss = "huber";
+  app.add_option("--loss", loss, "robust loss (default: the window's)")
+      ->check(CLI::IsMember({"none", "huber", "cauchy"}));
+  app.add_option("--loss-scale", win.loss_scale, "robust loss scale");
+  app.add_option("--ransac-thr", opt.ransac.inlier_threshold_px, "RANSAC inlier threshold, px");
+  app.add_option("--ransac-iters", opt.ransac.max_iterations, "RANSAC iterations");
+  app.add_option("--min-inliers", opt.ransac.min_inliers, "RANSAC minimum inliers");
+  app.add_option("--max-iters", win.max_num_iterations, "Ceres iterations per frame");
+  app.add_option("--max-time", win.max_solver_time_in_seconds, "Ceres time per frame, s");
+  double min_disparity = opt.ransac.min_disparity_px;
+  app.add_option("--min-disparity", min_disparity, "smallest disparity used, px");
+  app.add_option("--prior-rot-deg", win.motion_prior_sigma_rot_deg, "motion prior, deg");
+  app.add_option("--prior-trans-m", win.motion_prior_sigma_trans_m, "motion prior, m");
+  app.add_option("--seed", opt.seed, "RANSAC seed");
+  app.add_option("--log", args.log_path, "per-frame CSV log");
   sunvo::selfcal::StereoSelfCalibrationOptions selfcal_opt;  // issue 15: off unless --self-calib
-  std::string selfcal_log_path;
-  for (int i = 3; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto next = [&](double& v) {
-      if (i + 1 >= argc) return false;
-      char* end = nullptr;
-      v = std::strtod(argv[++i], &end);
-      return end != nullptr && *end == '\0';
-    };
-    double v = 0.0;
-    if (a == "--log") {
-      if (i + 1 >= argc) return usage("--log needs a path");
-      log_path = argv[++i];
-    } else if (a == "--self-calib") {
-      selfcal_opt.enabled = true;
-    } else if (a == "--self-calib-log") {
-      if (i + 1 >= argc) return usage("--self-calib-log needs a path");
-      selfcal_log_path = argv[++i];
-    } else if (a == "--no-window") {
-      opt.use_window = false;
-    } else if (a == "--loss") {
-      if (i + 1 >= argc) return usage("--loss needs a value");
-      const std::string l = argv[++i];
-      if (l == "none")
-        opt.window.loss = sunvo::backend::RobustLoss::kNone;
-      else if (l == "huber")
-        opt.window.loss = sunvo::backend::RobustLoss::kHuber;
-      else if (l == "cauchy")
-        opt.window.loss = sunvo::backend::RobustLoss::kCauchy;
-      else
-        return usage("--loss must be none, huber or cauchy");
-    } else if (!next(v)) {
-      return usage(("bad or missing value for " + a).c_str());
-    } else if (a == "--frames") {
-      max_frames = static_cast<long>(v);
-    } else if (a == "--window") {
-      opt.window.window_size = static_cast<int>(v);
-    } else if (a == "--sigma-uv") {
-      opt.window.sigma_u_px = opt.window.sigma_v_px = v;
-    } else if (a == "--sigma-d") {
-      opt.window.sigma_d_px = v;
-    } else if (a == "--loss-scale") {
-      opt.window.loss_scale = v;
-    } else if (a == "--ransac-thr") {
-      opt.ransac.inlier_threshold_px = v;
-    } else if (a == "--ransac-iters") {
-      opt.ransac.max_iterations = static_cast<int>(v);
-    } else if (a == "--min-inliers") {
-      opt.ransac.min_inliers = static_cast<int>(v);
-    } else if (a == "--max-iters") {
-      opt.window.max_num_iterations = static_cast<int>(v);
-    } else if (a == "--max-time") {
-      opt.window.max_solver_time_in_seconds = v;
-    } else if (a == "--min-disparity") {
-      opt.ransac.min_disparity_px = opt.window.min_disparity_px = v;
-    } else if (a == "--prior-rot-deg") {
-      opt.window.motion_prior_sigma_rot_deg = v;
-    } else if (a == "--prior-trans-m") {
-      opt.window.motion_prior_sigma_trans_m = v;
-    } else if (a == "--seed") {
-      opt.seed = static_cast<std::uint64_t>(v);
-    } else {
-      return usage(("unknown option " + a).c_str());
-    }
+  app.add_flag("--self-calib", selfcal_opt.enabled,
+               "online stereo self-calibration of the right camera before the odometry");
+  app.add_option("--self-calib-log", args.selfcal_log_path,
+                 "per-frame CSV of the self-calibration (pitch, roll, scale, resets)");
+  if (auto code = sunvo::cli::parse(app, argc, argv)) return *code;
+  if (app.count("--loss") > 0) {
+    win.loss = loss == "none"    ? sunvo::backend::RobustLoss::kNone
+               : loss == "huber" ? sunvo::backend::RobustLoss::kHuber
+                                 : sunvo::backend::RobustLoss::kCauchy;
   }
-  if (auto s = opt.validate(); !s.isOk()) return usage(s.toString().c_str());
+  if (app.count("--sigma-uv") > 0) win.sigma_u_px = win.sigma_v_px = sigma_uv;
+  if (app.count("--min-disparity") > 0) {
+    opt.ransac.min_disparity_px = win.min_disparity_px = min_disparity;
+  }
+  if (auto s = options.validate(); !s.isOk()) {
+    std::fprintf(stderr, "%s: %s\n", kProgram, s.toString().c_str());
+    return sunvo::cli::kExitUsage;
+  }
 
   static constexpr const char* kLoss[] = {"none", "huber", "cauchy"};
   std::printf(
       "options: window %d%s, ransac thr %.2f px iters %d min_inliers %d, sigma u/v/d "
       "%.2f/%.2f/%.2f px, loss %s scale %.2f, solver max_iter %d max_time %.3f s, "
       "min_disparity %.2f px, motion prior %.3f deg / %.3f m, seed %llu\n",
-      opt.window.window_size, opt.use_window ? "" : " (disabled)", opt.ransac.inlier_threshold_px,
-      opt.ransac.max_iterations, opt.ransac.min_inliers, opt.window.sigma_u_px,
-      opt.window.sigma_v_px, opt.window.sigma_d_px, kLoss[static_cast<int>(opt.window.loss)],
-      opt.window.loss_scale, opt.window.max_num_iterations, opt.window.max_solver_time_in_seconds,
-      opt.ransac.min_disparity_px, opt.window.motion_prior_sigma_rot_deg,
-      opt.window.motion_prior_sigma_trans_m, static_cast<unsigned long long>(opt.seed));
-  auto seq = sunvo::dataset::readTrackFolder(folder, sunvo::files::TrackReadOptions{});
-  if (!seq) {
-    std::fprintf(stderr, "sunvo_track_vo: %s\n", seq.status().toString().c_str());
-    return 1;
-  }
+      win.window_size, opt.use_window ? "" : " (disabled)", opt.ransac.inlier_threshold_px,
+      opt.ransac.max_iterations, opt.ransac.min_inliers, win.sigma_u_px, win.sigma_v_px,
+      win.sigma_d_px, kLoss[static_cast<int>(win.loss)], win.loss_scale, win.max_num_iterations,
+      win.max_solver_time_in_seconds, opt.ransac.min_disparity_px, win.motion_prior_sigma_rot_deg,
+      win.motion_prior_sigma_trans_m, static_cast<unsigned long long>(opt.seed));
+  auto seq = sunvo::dataset::readTrackFolder(args.folder, sunvo::files::TrackReadOptions{});
+  if (!seq) return sunvo::cli::fail(kProgram, seq.status());
   std::printf(
-      "tracks: image %dx%d from %s; %zu observations dropped past the border (max %.3f px)\n",
+      "tracks: image %dx%d from %s; %zu observations dropped past the border (max %.3f "
+      "px)\n",
       seq->camera.width, seq->camera.height, seq->image_size_source.c_str(),
       seq->dropped_past_border, seq->max_outside_px);
   std::size_t n = seq->frames.size();
-  if (max_frames > 0) n = std::min(n, static_cast<std::size_t>(max_frames));
+  if (args.max_frames > 0) n = std::min(n, static_cast<std::size_t>(args.max_frames));
 
-  sunvo::vo::StereoOdometry vo;
-  if (auto s = vo.init(opt, seq->camera, Isometry3::Identity()); !s.isOk()) {
-    std::fprintf(stderr, "sunvo_track_vo: %s\n", s.toString().c_str());
-    return 1;
+  sunvo::pipeline::SunAidedOdometry vo;
+  if (auto s = vo.init(options, seq->camera, Isometry3::Identity(),
+                       sunvo::pipeline::OdometryInput::kFeatures);
+      !s.isOk()) {
+    return sunvo::cli::fail(kProgram, s);
   }
   sunvo::selfcal::StereoSelfCalibration selfcal;
-  if (auto s = selfcal.init(selfcal_opt, seq->camera); !s.isOk())
-    return usage(s.toString().c_str());
+  if (auto s = selfcal.init(selfcal_opt, seq->camera); !s.isOk()) {
+    return sunvo::cli::fail(kProgram, s);
+  }
   sunvo::FrameFeatures corrected;
   std::FILE* selfcal_log =
-      selfcal_log_path.empty() ? nullptr : std::fopen(selfcal_log_path.c_str(), "w");
+      args.selfcal_log_path.empty() ? nullptr : std::fopen(args.selfcal_log_path.c_str(), "w");
+  if (!args.selfcal_log_path.empty() && selfcal_log == nullptr) {
+    return sunvo::cli::fail(kProgram, args.selfcal_log_path + ": cannot open for writing");
+  }
   if (selfcal_log != nullptr) {
     std::fprintf(selfcal_log, "frame,pitch_mrad,roll_mrad,scale,roll_sigma_mrad,used,reset\n");
   }
   std::vector<double> selfcal_ms;
   std::vector<Isometry3> poses;
   poses.reserve(n);
-  std::FILE* log = log_path.empty() ? nullptr : std::fopen(log_path.c_str(), "w");
+  std::FILE* log = args.log_path.empty() ? nullptr : std::fopen(args.log_path.c_str(), "w");
+  if (!args.log_path.empty() && log == nullptr) {
+    return sunvo::cli::fail(kProgram, args.log_path + ": cannot open for writing");
+  }
   if (log != nullptr) {
     std::fprintf(log,
                  "frame,status,matches,ransac_inliers,window_landmarks,window_residuals,"
@@ -191,8 +164,8 @@ int main(int argc, char** argv) {
     const double ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     if (!r) {
-      std::fprintf(stderr, "sunvo_track_vo: frame %zu: %s\n", k, r.status().toString().c_str());
-      return 1;
+      return sunvo::cli::fail(kProgram,
+                              "frame " + std::to_string(k) + ": " + r.status().toString());
     }
     poses.push_back(r->T_w_c);
     if (log != nullptr) {
@@ -224,9 +197,15 @@ int main(int argc, char** argv) {
   sunvo::files::Trajectory out_traj;
   out_traj.T_w_c = poses;
   for (std::size_t k = 0; k < poses.size(); ++k) out_traj.t_ns.push_back(seq->frames[k].time_ns);
-  if (auto s = sunvo::files::writeKittiPoses(out_path, out_traj); !s.isOk()) {
-    std::fprintf(stderr, "sunvo_track_vo: %s\n", s.toString().c_str());
-    return 1;
+  // out_poses names the KITTI file; the TUM file goes next to it (<base>_tum.txt).
+  std::string base = args.out_path;
+  if (base.size() > 4 && base.compare(base.size() - 4, 4, ".txt") == 0)
+    base.resize(base.size() - 4);
+  if (base + ".txt" != args.out_path) {
+    return sunvo::cli::fail(kProgram, args.out_path + ": the pose file's name must end in .txt");
+  }
+  if (auto s = sunvo::files::writeTrajectoryFiles(base, out_traj); !s.isOk()) {
+    return sunvo::cli::fail(kProgram, s);
   }
   std::printf(
       "frames %zu  lost %d  recovered %d  window fallbacks %d  mean solver iterations %.2f\n", n,

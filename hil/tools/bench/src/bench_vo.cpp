@@ -1,4 +1,4 @@
-// Full image VO benchmark on real KITTI images: StereoVisualOdometry (front end + 3-point RANSAC +
+// Full image VO benchmark on real KITTI images: StereoImageOdometry (front end + 3-point RANSAC +
 // Ceres window) on the 11 frames of 00_first_frames played forward and backward (0..10..0..),
 // single-threaded (cv::setNumThreads(0); the pipeline starts no threads). Prints per-stage wall
 // time median/p95/p99/max, heap allocations per frame per stage in steady state, the resident set
@@ -10,7 +10,7 @@
 // back end of the second run makes the same association + RANSAC calls: its allocations are
 // RANSAC's, and the window's are the full run's back-end allocations minus those.
 //
-// A third run times the back end alone (vo::StereoOdometry, track mode) on the real feature tracks
+// A third run times the back end alone (vo::StereoTrackOdometry, track mode) on the real feature tracks
 // of KITTI 2011_09_30_drive_0020 (1000 frames, SURF+KLT tracks, ~65 observations per frame).
 //
 // Usage: sunvo_bench_vo [--frames=N] [--warmup=N] [--data=DIR] [--tracks=DIR|--tracks=]
@@ -32,7 +32,7 @@
 #include "sunvo/runtime/alloc_counter.hpp"
 #include "sunvo/bench/bench_support.hpp"
 #include "sunvo/files/tracks_io.hpp"
-#include "sunvo/pipeline/stereo_visual_odometry.hpp"
+#include "sunvo/pipeline/stereo_image_odometry.hpp"
 
 namespace {
 
@@ -74,7 +74,7 @@ sunvo::files::TrackSequence g_track_seq;
 void runPipeline(benchmark::State& state, bool use_window, Run& r) {
   sunvo::pipeline::PipelineOptions opt;
   opt.vo.use_window = use_window;
-  sunvo::pipeline::StereoVisualOdometry vo;
+  sunvo::pipeline::StereoImageOdometry vo;
   const sunvo::Status st = vo.init(opt, g_data.camera);
   if (!st.isOk()) {
     state.SkipWithError(st.toString().c_str());
@@ -175,7 +175,7 @@ void runPipeline(benchmark::State& state, bool use_window, Run& r) {
 // The back end alone on recorded real tracks: every frame of the sequence once, in order.
 void benchTracks(benchmark::State& state) {
   Run& r = g_tracks;
-  sunvo::vo::StereoOdometry vo;
+  sunvo::vo::StereoTrackOdometry vo;
   const sunvo::Status st =
       vo.init(sunvo::vo::VoOptions{}, g_track_seq.camera, sunvo::Isometry3::Identity());
   if (!st.isOk()) {
@@ -297,7 +297,7 @@ void printTracks(const Run& r) {
   row("association + RANSAC", r.ransac_ms);
   row("window + Ceres", r.window_ms);
   row("  of which Ceres Solve() (own timer)", r.ceres_ms);
-  row("StereoOdometry::process() total", r.odometry_ms);
+  row("StereoTrackOdometry::process() total", r.odometry_ms);
   row("thread CPU time", r.cpu_ms);
   row("heap allocations per frame", r.alloc_odometry);
   std::printf(

@@ -25,7 +25,7 @@
 #include "sunvo/core/geometry.hpp"
 #include "sunvo/core/status.hpp"
 #include "sunvo/core/stereo_frame.hpp"
-#include "sunvo/pipeline/stereo_visual_odometry.hpp"
+#include "sunvo/pipeline/stereo_image_odometry.hpp"
 #include "sunvo/sunfusion/sun_window_term.hpp"
 
 namespace sunvo::pipeline {
@@ -36,7 +36,7 @@ struct SunAidedOptions {
   int every_n_frames = 5;              // a sun measurement every n-th frame, [1, 1000]
   sunfusion::SunFusionOptions fusion;  // gate, world "up", attitude model (sun_window_term.hpp)
 
-  // The error names the bad key ("sun_aided.every_n_frames", "pipeline.*", "sun_fusion.*").
+  // The error names the bad key relative to these options ("every_n_frames", "fusion.x", "window.x").
   Status validate() const;
   // The pipeline's fields are listed at this level; use_sun is the program's to set (the rover:
   // sun.provider).
@@ -82,20 +82,20 @@ class SunAidedOdometry {
   // The rover shrinks the solver's time budget when a frame is late (seconds, > 0).
   void setSolverTimeBudget(double seconds);
   // A monotonically increasing event count sampled around the front end and the back end.
-  void setStageCounter(StereoVisualOdometry::StageCounter counter) { vo_.setStageCounter(counter); }
+  void setStageCounter(StereoImageOdometry::StageCounter counter) { vo_.setStageCounter(counter); }
   // The features of the last image frame (valid until the next call).
   const FrameFeatures& lastFeatures() const { return vo_.lastFeatures(); }
   const SunAidedOptions& options() const { return options_; }
 
  private:
-  vo::StereoOdometry& backEnd() {
+  vo::StereoTrackOdometry& backEnd() {
     return input_ == OdometryInput::kImages ? vo_.odometry() : tracks_;
   }
 
   SunAidedOptions options_;
   OdometryInput input_ = OdometryInput::kImages;
-  StereoVisualOdometry vo_;    // image input: front end + its own back end
-  vo::StereoOdometry tracks_;  // feature input: the back end alone
+  StereoImageOdometry vo_;    // image input: front end + its own back end
+  vo::StereoTrackOdometry tracks_;  // feature input: the back end alone
   sunfusion::SunWindowTerm sun_term_;
   Isometry3 T_w_c_ = Isometry3::Identity();
   std::uint64_t sun_offered_ = 0;

@@ -6,7 +6,7 @@
 // (core/fields.hpp); the `estimator` section is the estimator's own pipeline::SunAidedOptions
 // (estimator.window.max_num_iterations, estimator.frontend.max_features, estimator.fusion.*).
 // Every option has a default (below or in its struct), with its unit and range. Unknown keys are
-// rejected; a bad value names its key and the file ("config/rover.yaml: estimator: window.x must
+// rejected; a bad value names its key and the file ("config/rover.yaml: estimator.window.x must
 // be ..."); a value of the wrong type also names the line. Command-line overrides use the same
 // keys ("--set source.kitti.drive_dir=/data/drive").
 

@@ -24,7 +24,7 @@
 #include "sunvo/sunfusion/simulated_sun_source.hpp"
 #include "sunvo/sunfusion/sun_gate.hpp"
 #include "sunvo/sunfusion/sun_window_term.hpp"
-#include "sunvo/vo/stereo_odometry.hpp"
+#include "sunvo/vo/stereo_track_odometry.hpp"
 
 namespace sunvo::experiment {
 

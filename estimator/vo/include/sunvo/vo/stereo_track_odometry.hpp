@@ -1,5 +1,6 @@
 #pragma once
-// Stereo visual odometry back end: FrameFeatures in, world pose out.
+// Stereo track odometry (the back end): tracked stereo features (FrameFeatures: landmark id, left
+// and right pixel) in, world pose out. Images go in through pipeline::StereoImageOdometry.
 //
 // Per frame k: associate observations with frame k-1 by landmark id, 3-point RANSAC for the
 // initial motion T_k_km1 and outlier rejection, then the bounded Ceres window (base b = oldest
@@ -73,7 +74,7 @@ struct VoResult {
                                // frame was bridged; 0 = none)
 };
 
-class StereoOdometry {
+class StereoTrackOdometry {
  public:
   Status init(const VoOptions& options, const StereoCamera& camera, const Isometry3& T_w_c0);
   Expected<VoResult> process(const FrameFeatures& frame);

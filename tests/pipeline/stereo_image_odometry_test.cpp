@@ -1,4 +1,4 @@
-#include "sunvo/pipeline/stereo_visual_odometry.hpp"
+#include "sunvo/pipeline/stereo_image_odometry.hpp"
 
 #include <gtest/gtest.h>
 
@@ -75,7 +75,7 @@ TEST(PipelineOptions, DefaultsValidAndBadKeysNamed) {
 }
 
 TEST_F(KittiPipeline, ProcessBeforeInitAndWrongImagesAreErrors) {
-  StereoVisualOdometry vo;
+  StereoImageOdometry vo;
   EXPECT_FALSE(vo.process(data_->frames[0]).hasValue());
   ASSERT_TRUE(vo.init(PipelineOptions{}, data_->camera).isOk());
   StereoFrame bad;
@@ -89,7 +89,7 @@ TEST_F(KittiPipeline, ProcessBeforeInitAndWrongImagesAreErrors) {
 // directions, and the translation length (the GT's constant 0.859 m/frame is not trusted there;
 // independent stereo VO systems measure 0.68 -> 0.82 m, see data/README.md).
 TEST_F(KittiPipeline, RealFramesMatchGroundTruthDirectionAndRotation) {
-  StereoVisualOdometry vo;
+  StereoImageOdometry vo;
   ASSERT_TRUE(vo.init(PipelineOptions{}, data_->camera, (*gt_)[0]).isOk());
   std::vector<Isometry3> T_w_c;
   for (std::size_t k = 0; k < data_->frames.size(); ++k) {
@@ -176,7 +176,7 @@ TEST_F(KittiPipeline, FrontendStageAllocatesNothingPerFrame) {
   GTEST_SKIP() << "no allocation counter in this build";
 #else
   ASSERT_TRUE(runtime::allocCounterActive());
-  StereoVisualOdometry vo;
+  StereoImageOdometry vo;
   ASSERT_TRUE(vo.init(PipelineOptions{}, data_->camera).isOk());
   vo.setStageCounter(&runtime::allocationCount);
   std::uint64_t frontend = 0;
@@ -221,7 +221,7 @@ TEST_F(KittiPipeline, DegenerateImagesAreLostThenRecovered) {
   frames[6].left = noise_l;
   frames[6].right = noise_r;
 
-  StereoVisualOdometry vo;
+  StereoImageOdometry vo;
   ASSERT_TRUE(vo.init(PipelineOptions{}, data_->camera, (*gt_)[0]).isOk());
   std::vector<FrameResult> results;
   for (std::size_t k = 0; k < frames.size(); ++k) {

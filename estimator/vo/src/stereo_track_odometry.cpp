@@ -1,4 +1,4 @@
-#include "sunvo/vo/stereo_odometry.hpp"
+#include "sunvo/vo/stereo_track_odometry.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -23,7 +23,7 @@ std::uint64_t mixSeed(std::uint64_t x) {
 
 // Frames between a reference and the new frame, at least 1 (sequence numbers that repeat or go
 // back are treated as consecutive).
-double StereoOdometry::frameGap(const FrameFeatures& frame, const RefFrame& ref) {
+double StereoTrackOdometry::frameGap(const FrameFeatures& frame, const RefFrame& ref) {
   const auto d = static_cast<std::int64_t>(frame.sequence - ref.sequence);
   return d < 1 ? 1.0 : static_cast<double>(d);
 }
@@ -45,12 +45,12 @@ const char* toString(TrackingStatus s) {
 Status VoOptions::validate() const {
   SUNVO_RETURN_IF_ERROR(ransac.validate());
   SUNVO_RETURN_IF_ERROR(window.validate());
-  if (max_observations < 3) return invalidArgument("vo.max_observations must be >= 3");
+  if (max_observations < 3) return invalidArgument("max_observations must be >= 3");
   if (ransac.max_observations < max_observations) {
-    return invalidArgument("ransac.max_observations must be >= vo.max_observations");
+    return invalidArgument("ransac.max_observations must be >= max_observations");
   }
   if (window.max_observations_per_frame < max_observations) {
-    return invalidArgument("window.max_observations_per_frame must be >= vo.max_observations");
+    return invalidArgument("window.max_observations_per_frame must be >= max_observations");
   }
   if (!(max_translation_per_frame_m > 0.0)) {
     return invalidArgument("vo.max_translation_per_frame_m must be > 0");
@@ -58,7 +58,7 @@ Status VoOptions::validate() const {
   return Status::ok();
 }
 
-Status StereoOdometry::init(const VoOptions& options, const StereoCamera& camera,
+Status StereoTrackOdometry::init(const VoOptions& options, const StereoCamera& camera,
                             const Isometry3& T_w_c0) {
   SUNVO_RETURN_IF_ERROR(options.validate());
   SUNVO_RETURN_IF_ERROR(camera.validate());
@@ -86,7 +86,7 @@ Status StereoOdometry::init(const VoOptions& options, const StereoCamera& camera
   return Status::ok();
 }
 
-void StereoOdometry::store(RefFrame& ref, const FrameFeatures& frame, const Isometry3& T_w_c) {
+void StereoTrackOdometry::store(RefFrame& ref, const FrameFeatures& frame, const Isometry3& T_w_c) {
   ref.count = static_cast<int>(frame.observations.size());
   for (int i = 0; i < ref.count; ++i) {
     const auto ui = static_cast<std::size_t>(i);
@@ -103,7 +103,7 @@ void StereoOdometry::store(RefFrame& ref, const FrameFeatures& frame, const Isom
 
 // Association by landmark id (binary search in the reference's sorted ids); fills matches_ and
 // match_cur_index_ (increasing current-frame indices).
-int StereoOdometry::associate(const RefFrame& ref, const FrameFeatures& frame) {
+int StereoTrackOdometry::associate(const RefFrame& ref, const FrameFeatures& frame) {
   int n = 0;
   const auto sorted_end = ref.sorted.begin() + ref.count;
   for (std::size_t i = 0; i < frame.observations.size(); ++i) {
@@ -120,7 +120,7 @@ int StereoOdometry::associate(const RefFrame& ref, const FrameFeatures& frame) {
 }
 
 // Window observations of a frame that starts a window: every one with positive disparity.
-int StereoOdometry::baseObservations(const RefFrame& ref) {
+int StereoTrackOdometry::baseObservations(const RefFrame& ref) {
   int n = 0;
   for (int i = 0; i < ref.count; ++i) {
     const StereoObservation& o = ref.obs[static_cast<std::size_t>(i)];
@@ -131,7 +131,7 @@ int StereoOdometry::baseObservations(const RefFrame& ref) {
   return n;
 }
 
-Status StereoOdometry::restartWindowAt(const RefFrame& ref) {
+Status StereoTrackOdometry::restartWindowAt(const RefFrame& ref) {
   if (!options_.use_window) return Status::ok();
   window_.reset(ref.T_w_c);
   const int n = baseObservations(ref);
@@ -140,13 +140,13 @@ Status StereoOdometry::restartWindowAt(const RefFrame& ref) {
                           Isometry3::Identity());
 }
 
-Expected<VoResult> StereoOdometry::process(const FrameFeatures& frame) {
-  if (!initialized_) return failedPrecondition("StereoOdometry::process before init");
+Expected<VoResult> StereoTrackOdometry::process(const FrameFeatures& frame) {
+  if (!initialized_) return failedPrecondition("StereoTrackOdometry::process before init");
   if (frame.observations.size() > static_cast<std::size_t>(options_.max_observations)) {
     return invalidArgument(
         "vo: frame " + std::to_string(frame.sequence) + " has " +
         std::to_string(frame.observations.size()) +
-        " observations > vo.max_observations = " + std::to_string(options_.max_observations));
+        " observations > max_observations = " + std::to_string(options_.max_observations));
   }
   VoResult r;
   r.sequence = frame.sequence;

@@ -1,4 +1,4 @@
-#include "sunvo/vo/stereo_odometry.hpp"
+#include "sunvo/vo/stereo_track_odometry.hpp"
 
 #include <gtest/gtest.h>
 
@@ -47,10 +47,10 @@ VoOptions noisyOptions() {
 // 30 frames, 1 m/frame with 1 deg yaw, 1 px noise, 30 % outliers per frame (outlier tracks keep
 // their ids, like wrong KLT tracks). Measured: final position error 0.047 m after 29 m (0.16 %),
 // final rotation error 0.23 deg. Bounds with margin: 1 % of the distance and 0.4 deg.
-TEST(StereoOdometry, TracksASyntheticDriveWithNoiseAndOutliers) {
+TEST(StereoTrackOdometry, TracksASyntheticDriveWithNoiseAndOutliers) {
   const Isometry3 T_k_km1 = testing::forwardMotion(1.0, 1.0, 0.1);
   const Drive d = makeDrive(30, 1.0, 0.3, T_k_km1);
-  StereoOdometry vo;
+  StereoTrackOdometry vo;
   ASSERT_TRUE(vo.init(noisyOptions(), kittiCamera(), Isometry3::Identity()).isOk());
   Isometry3 last = Isometry3::Identity();
   for (std::size_t k = 0; k < d.frames.size(); ++k) {
@@ -75,7 +75,7 @@ TEST(StereoOdometry, TracksASyntheticDriveWithNoiseAndOutliers) {
 // frame, 0.3 px noise. Checks that the estimator itself does not drift systematically (the real
 // route drifts ~0.01 deg/frame per axis, this must stay far below). Measured: final rotation
 // error 0.107 deg, position error 0.194 m over 329 m (0.06 %). Bounds: 0.5 deg and 1 m (0.3 %).
-TEST(StereoOdometry, LongSparseSyntheticDriveHasNoSystematicDrift) {
+TEST(StereoTrackOdometry, LongSparseSyntheticDriveHasNoSystematicDrift) {
   testing::SceneOptions so;
   so.pixel_noise_px = 0.3;
   so.max_per_frame = 60;
@@ -86,7 +86,7 @@ TEST(StereoOdometry, LongSparseSyntheticDriveHasNoSystematicDrift) {
   const auto T_w_k = testing::trajectory(n, T_k_km1);
   const auto pts = testing::makeLandmarks(so, n * 1.1);
   VoOptions o;
-  StereoOdometry vo;
+  StereoTrackOdometry vo;
   ASSERT_TRUE(vo.init(o, kittiCamera(), Isometry3::Identity()).isOk());
   Isometry3 last = Isometry3::Identity();
   int lost = 0;
@@ -113,11 +113,11 @@ TEST(StereoOdometry, LongSparseSyntheticDriveHasNoSystematicDrift) {
 // Degenerate frames: no observations, no matches, all points at infinity. Each is reported kLost
 // with a finite pose; the next good frame is kRecovered and the trajectory is still right (the
 // lost frame is bridged by matching with the last good frame).
-TEST(StereoOdometry, DegenerateFramesAreLostThenRecovered) {
+TEST(StereoTrackOdometry, DegenerateFramesAreLostThenRecovered) {
   const Isometry3 T_k_km1 = testing::forwardMotion(1.0, 0.5);
   const Drive d = makeDrive(14, 0.3, 0.0, T_k_km1);
   VoOptions o;
-  StereoOdometry vo;
+  StereoTrackOdometry vo;
   ASSERT_TRUE(vo.init(o, kittiCamera(), Isometry3::Identity()).isOk());
 
   FrameFeatures empty;
@@ -158,9 +158,9 @@ TEST(StereoOdometry, DegenerateFramesAreLostThenRecovered) {
 }
 
 // Zero motion is not degenerate for stereo: it is tracked and stays at identity.
-TEST(StereoOdometry, ZeroMotionIsTrackedAtIdentity) {
+TEST(StereoTrackOdometry, ZeroMotionIsTrackedAtIdentity) {
   const Drive d = makeDrive(2, 0.0, 0.0, Isometry3::Identity());
-  StereoOdometry vo;
+  StereoTrackOdometry vo;
   ASSERT_TRUE(vo.init(VoOptions{}, kittiCamera(), Isometry3::Identity()).isOk());
   for (int k = 0; k < 5; ++k) {
     FrameFeatures f = d.frames[0];
@@ -187,7 +187,7 @@ TEST(VoOptions, ValidateNamesTheBadKey) {
   o = VoOptions{};
   o.max_translation_per_frame_m = 0.0;
   EXPECT_NE(o.validate().message().find("vo.max_translation_per_frame_m"), std::string::npos);
-  StereoOdometry vo;
+  StereoTrackOdometry vo;
   EXPECT_FALSE(vo.process(FrameFeatures{}));  // before init
 }
 
@@ -195,11 +195,11 @@ TEST(VoOptions, ValidateNamesTheBadKey) {
 // options. Measured (see the report): translational ARMSE 2.106 m, final drift 10.19 m, final
 // rotation error 6.09 deg, 3 lost frames (frame 1 and the 5-match frames 53-54). Bounds are
 // the measurement plus about 20 %.
-TEST(StereoOdometry, ReplayRegressionOnReal0020Tracks) {
+TEST(StereoTrackOdometry, ReplayRegressionOnReal0020Tracks) {
   const std::string dir = std::string(SUNVO_DATA_DIR) + "/kitti_tracks/2011_09_30_drive_0020";
   auto seq = files::readTrackFolder(dir, files::TrackReadOptions{});
   ASSERT_TRUE(seq) << seq.status().toString();
-  StereoOdometry vo;
+  StereoTrackOdometry vo;
   ASSERT_TRUE(vo.init(VoOptions{}, seq->camera, Isometry3::Identity()).isOk());
   const std::size_t n = 200;
   double armse = 0.0;

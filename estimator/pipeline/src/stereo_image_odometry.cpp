@@ -1,4 +1,4 @@
-#include "sunvo/pipeline/stereo_visual_odometry.hpp"
+#include "sunvo/pipeline/stereo_image_odometry.hpp"
 
 #include <chrono>
 #include <cmath>
@@ -9,7 +9,7 @@ namespace sunvo::pipeline {
 namespace {
 
 Status badKey(const char* key, const std::string& what) {
-  return invalidArgument(std::string("pipeline.") + key + ": " + what);
+  return invalidArgument(std::string(key) + ": " + what);
 }
 
 double msBetween(std::chrono::steady_clock::time_point a, std::chrono::steady_clock::time_point b) {
@@ -33,7 +33,7 @@ Status PipelineOptions::validate() const {
   SUNVO_RETURN_IF_ERROR(frontend.validate());
   SUNVO_RETURN_IF_ERROR(vo.validate());
   if (frontend.max_features > vo.max_observations) {
-    return badKey("frontend.max_features", "must be <= vo.max_observations (" +
+    return badKey("frontend.max_features", "must be <= max_observations (" +
                                                std::to_string(vo.max_observations) + "), is " +
                                                std::to_string(frontend.max_features));
   }
@@ -43,7 +43,7 @@ Status PipelineOptions::validate() const {
   return Status::ok();
 }
 
-Status StereoVisualOdometry::init(const PipelineOptions& options, const StereoCamera& camera,
+Status StereoImageOdometry::init(const PipelineOptions& options, const StereoCamera& camera,
                                   const Isometry3& T_w_c0) {
   initialized_ = false;
   SUNVO_RETURN_IF_ERROR(options.validate());
@@ -66,7 +66,7 @@ Status StereoVisualOdometry::init(const PipelineOptions& options, const StereoCa
 // so the image content near the centre shifts by (fu r02 / r22, fv r12 / r22). Near points also
 // move with the translation (depth-dependent); the front end's per-feature constant image velocity
 // prediction covers those once a feature has a history.
-bool StereoVisualOdometry::rotationShift(const Isometry3& T_k_km1, float* du, float* dv) const {
+bool StereoImageOdometry::rotationShift(const Isometry3& T_k_km1, float* du, float* dv) const {
   const Eigen::Matrix3d R = T_k_km1.linear();
   const double r22 = R(2, 2);
   if (!(r22 > 1e-3)) return false;
@@ -79,8 +79,8 @@ bool StereoVisualOdometry::rotationShift(const Isometry3& T_k_km1, float* du, fl
   return true;
 }
 
-Expected<FrameResult> StereoVisualOdometry::process(const StereoFrame& frame) {
-  if (!initialized_) return failedPrecondition("StereoVisualOdometry::process before init");
+Expected<FrameResult> StereoImageOdometry::process(const StereoFrame& frame) {
+  if (!initialized_) return failedPrecondition("StereoImageOdometry::process before init");
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
   const double cpu0 = threadCpuMs();

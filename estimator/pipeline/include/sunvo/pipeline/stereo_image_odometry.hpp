@@ -1,9 +1,9 @@
 #pragma once
 // Image stereo visual odometry: StereoFrontend (keypoints, stereo and temporal matching, landmark
-// ids) followed by vo::StereoOdometry (3-point RANSAC + bounded Ceres window) behind one
+// ids) followed by vo::StereoTrackOdometry (3-point RANSAC + bounded Ceres window) behind one
 // synchronous call per rectified stereo pair.
 //
-//   StereoVisualOdometry vo;
+//   StereoImageOdometry vo;
 //   SUNVO_RETURN_IF_ERROR(vo.init(PipelineOptions{}, camera));   // allocates the buffers
 //   Expected<FrameResult> r = vo.process(frame);                 // per frame
 //
@@ -30,7 +30,7 @@
 #include "sunvo/core/status.hpp"
 #include "sunvo/core/stereo_frame.hpp"
 #include "sunvo/frontend/stereo_frontend.hpp"
-#include "sunvo/vo/stereo_odometry.hpp"
+#include "sunvo/vo/stereo_track_odometry.hpp"
 
 namespace sunvo::pipeline {
 
@@ -43,14 +43,15 @@ inline FrontendOptions defaultPipelineFrontendOptions() {
 }
 
 struct PipelineOptions {
-  // See stereo_frontend.hpp; frontend.max_features must be <= vo.max_observations.
+  // See stereo_frontend.hpp; frontend.max_features must be <= max_observations (vo).
   FrontendOptions frontend = defaultPipelineFrontendOptions();
-  vo::VoOptions vo;            // see stereo_odometry.hpp
+  vo::VoOptions vo;            // see stereo_track_odometry.hpp
   bool rotation_hint = true;   // centre the front end's un-predicted temporal search on the image
                                //   shift of the last measured rotation (see the header comment)
   double max_hint_px = 100.0;  // px, [0, 1000]: a larger predicted shift is not used as a hint
 
-  // The error names the bad key ("frontend option 'x'", "vo.x", "pipeline.x").
+  // The error names the bad key as the config names it, relative to the options ("frontend.x",
+  // "window.x", "ransac.x", "max_hint_px"); the rover prefixes "estimator.".
   Status validate() const;
   // The back end's fields are listed at this level (estimator.window.*, estimator.ransac.*).
   template <class Self, class V>
@@ -95,7 +96,7 @@ struct FrameResult {
   std::uint64_t odometry_counter_delta = 0;
 };
 
-class StereoVisualOdometry {
+class StereoImageOdometry {
  public:
   // A monotonically increasing event count sampled around each stage (e.g. heap allocations).
   using StageCounter = std::uint64_t (*)();
@@ -117,7 +118,7 @@ class StereoVisualOdometry {
   void setStageCounter(StageCounter counter) { counter_ = counter; }
 
   StereoFrontend& frontend() { return frontend_; }
-  vo::StereoOdometry& odometry() { return odometry_; }  // e.g. its window's residual hook
+  vo::StereoTrackOdometry& odometry() { return odometry_; }  // e.g. its window's residual hook
   const PipelineOptions& options() const { return options_; }
 
  private:
@@ -128,7 +129,7 @@ class StereoVisualOdometry {
   PipelineOptions options_;
   StereoCamera camera_;
   StereoFrontend frontend_;
-  vo::StereoOdometry odometry_;
+  vo::StereoTrackOdometry odometry_;
   FrameFeatures features_;
   StageCounter counter_ = nullptr;
   bool initialized_ = false;
