@@ -123,6 +123,11 @@ TEST(TracksIo, DropsAndCountsObservationsJustPastTheBorder) {
   ASSERT_EQ(r->frames[1].observations.size(), 1u);
   EXPECT_DOUBLE_EQ(r->frames[1].observations[0].u_left, 1241.9);
   EXPECT_TRUE(r->frames[2].observations.empty());
+  // The strict form (and tolerance 0): the same 0.4 px is an error naming the row and field.
+  auto strict_form = TextFile::fromString("tracks.csv", h + "0,1,100,375.4,90,375.3\n");
+  EXPECT_EQ(parseTracks(strict_form, kTimes, 1242, 375).status().message(),
+            "tracks.csv:2: field 'vL': outside the image [0, 375) by more than the 0.000 px "
+            "tolerance: 375.4");
   // Tolerance 0: the same 0.4 px is an error naming the row and field.
   auto strict = TextFile::fromString("tracks.csv", h + "0,1,100,375.4,90,375.3\n");
   auto e = parseTracks(strict, kTimes, TrackBounds{1242, 375, 0.0});

@@ -185,6 +185,16 @@ Expected<ParsedTracks> parseTracks(TextFile& file, const std::vector<TimeNs>& ti
   return out;
 }
 
+Expected<std::vector<FrameFeatures>> parseTracks(TextFile& file, const std::vector<TimeNs>& times,
+                                                 int image_width, int image_height) {
+  if (image_width <= 0 || image_height <= 0) {
+    return invalidArgument("parseTracks: image_width and image_height must be > 0 px");
+  }
+  auto parsed = parseTracks(file, times, TrackBounds{image_width, image_height, 0.0});
+  if (!parsed) return parsed.status();
+  return std::move(parsed->frames);
+}
+
 namespace {
 // The smallest whole-pixel size that holds the extent; it must fit the principal point c.
 Expected<int> sizeFromExtent(const std::string& path, const TrackExtent& e, double c,

@@ -89,6 +89,10 @@ Expected<StereoCamera> parseTrackCalib(TextFile& file, int image_width, int imag
 // tracks.csv for times.size() frames; times[k] becomes frames[k].time_ns.
 Expected<ParsedTracks> parseTracks(TextFile& file, const std::vector<TimeNs>& times,
                                    const TrackBounds& bounds);
+// The strict form: every observation inside [0, image_width) x [0, image_height) (> 0), no
+// tolerance, no counts.
+Expected<std::vector<FrameFeatures>> parseTracks(TextFile& file, const std::vector<TimeNs>& times,
+                                                 int image_width, int image_height);
 
 // Reads a whole track folder; times.txt and gt_poses.txt go through trajectory_io.hpp
 // (readTimes: exact decimal seconds to ns; readKittiPoses).
