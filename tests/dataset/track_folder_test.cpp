@@ -50,6 +50,12 @@ TEST(TrackFolder, A2011_10_03FolderLoadsWithItsRigSize) {
   EXPECT_EQ(ds->droppedPastBorder(), 0u);
   EXPECT_EQ(ds->features()[0].observations.size(), 2u);
   EXPECT_NE(ds->describe().find("0 observations dropped past the border"), std::string::npos);
+  // The folder's name also when it is given as "<folder>/." or with a trailing '/'.
+  for (const std::string& spelling : {o.path + "/.", o.path + "/"}) {
+    auto seq = dataset::readTrackFolder(spelling, files::TrackReadOptions{});
+    ASSERT_TRUE(seq) << spelling << ": " << seq.status().toString();
+    EXPECT_EQ(seq->image_size_source, "the KITTI 2011_10_03 rig") << spelling;
+  }
 }
 
 TEST(TrackFolder, KittiCamToCamSizeDropsAndCountsTheRowJustPastTheBorder) {

@@ -13,8 +13,9 @@ Expected<files::TrackSequence> readTrackFolder(const std::string& folder,
                                                files::TrackReadOptions options) {
   SUNVO_RETURN_IF_ERROR(options.validate());
   if (options.image_width > 0) return files::readTrackFolder(folder, options);
-  fs::path dir(folder);
-  if (dir.filename().empty()) dir = dir.parent_path();  // a trailing '/'
+  // The folder's own name even for "." or a trailing '/'.
+  fs::path dir = fs::absolute(fs::path(folder)).lexically_normal();
+  if (dir.filename().empty()) dir = dir.parent_path();
   auto calib_file = files::TextFile::open((dir / "calib.txt").string());
   if (!calib_file) return calib_file.status();
   bool has_size = false;
