@@ -150,7 +150,8 @@ Expected<ParsedTracks> parseTracks(TextFile& file, const std::vector<TimeNs>& ti
       px[i] = *x;
       // Inside: [0, limit); limit 0 = not known yet, no upper border.
       const int limit = (i % 2 == 0) ? bounds.width : bounds.height;
-      const bool below = *x<0.0, above = limit> 0 && *x >= limit;
+      const bool below = *x < 0.0;
+      const bool above = limit > 0 && *x >= limit;
       if (!below && !above) continue;
       const double past = below ? -*x : *x - limit;  // px past the border
       if (past > tol) {
