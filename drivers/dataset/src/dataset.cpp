@@ -5,6 +5,7 @@
 
 #include "loader.hpp"
 #include "sunvo/files/sun_csv.hpp"
+#include "sunvo/files/tracks_io.hpp"
 
 namespace sunvo::dataset {
 namespace fs = std::filesystem;
@@ -56,6 +57,13 @@ Status DatasetOptions::validate() const {
   }
   if (odometry_start_utc_ns < 0) return invalidArgument("dataset.odometry_start_utc_ns: < 0");
   if (first_frame < 0) return invalidArgument("dataset.first_frame: must be >= 0");
+  files::TrackReadOptions track;
+  track.image_width = image_width;
+  track.image_height = image_height;
+  track.border_tolerance_px = border_tolerance_px;
+  if (Status s = track.validate(); !s.isOk()) {
+    return invalidArgument("dataset.image_width/image_height/border_tolerance_px: " + s.message());
+  }
   if (last_frame < -1 || (last_frame != -1 && last_frame < first_frame)) {
     return invalidArgument("dataset.last_frame: must be -1 (to the end) or >= first_frame");
   }
@@ -113,7 +121,7 @@ kitti::KittiSourceOptions Dataset::imageSourceOptions() const {
 }
 
 std::string Dataset::describe() const {
-  char buf[512];
+  char buf[768];
   std::snprintf(
       buf, sizeof(buf), "%s '%s': %zu frames, camera %dx%d fu %.2f b %.4f m, world %s%s%s%s%s",
       toString(kind_), name_.c_str(), size(), camera_.width, camera_.height, camera_.fu,
@@ -121,7 +129,12 @@ std::string Dataset::describe() const {
       hasGroundTruth() ? ", ground truth" : ", no ground truth",
       sunKnown() ? ", true sun" : ", sun unknown", hasImages() ? ", images" : "",
       hasFeatures() ? ", feature tracks" : "");
-  return buf;
+  std::string out = buf;
+  if (kind_ == DatasetKind::kTrackFolder) {
+    out += " (image size from " + image_size_source_ + "; " + std::to_string(dropped_past_border_) +
+           " observations dropped past the border)";
+  }
+  return out;
 }
 
 std::vector<TrueSun> sunFromWorld(const std::vector<Eigen::Vector3d>& sun_w,

@@ -40,11 +40,21 @@ std::optional<std::string> kittiOdometryDrive(const std::string& sequence) {
   return std::string(kDrives[n]);
 }
 
+namespace {
+const KittiRig k1003{"2011_10_03", 718.856, 607.1928, 185.2157, -386.1448, 1241, 376};
+const KittiRig k0926{"2011_09_26", 721.5377, 609.5593, 172.854, -387.5744, 1242, 375};
+const KittiRig k0930{"2011_09_30", 707.0912, 601.8873, 183.1104, -379.8145, 1226, 370};
+}  // namespace
+
+std::optional<KittiRig> kittiRigOfDay(const std::string& name) {
+  for (const KittiRig* rig : {&k1003, &k0926, &k0930}) {
+    if (name.rfind(rig->date, 0) == 0) return *rig;
+  }
+  return std::nullopt;
+}
+
 std::optional<KittiRig> kittiOdometryRig(const std::string& sequence) {
   const int n = sequenceNumber(sequence);
-  static const KittiRig k1003{"2011_10_03", 718.856, 607.1928, 185.2157, -386.1448, 1241, 376};
-  static const KittiRig k0926{"2011_09_26", 721.5377, 609.5593, 172.854, -387.5744, 1242, 375};
-  static const KittiRig k0930{"2011_09_30", 707.0912, 601.8873, 183.1104, -379.8145, 1226, 370};
   if (n >= 0 && n <= 2) return k1003;
   if (n == 3) return k0926;
   if (n >= 4 && n <= 10) return k0930;

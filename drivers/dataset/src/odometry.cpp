@@ -5,6 +5,7 @@
 
 #include "loader.hpp"
 #include "sunvo/dataset/kitti_rigs.hpp"
+#include "sunvo/dataset/track_folder.hpp"
 #include "sunvo/files/text_file.hpp"
 #include "sunvo/files/tracks_io.hpp"
 #include "sunvo/files/trajectory_io.hpp"
@@ -112,8 +113,13 @@ Expected<Dataset> DatasetLoader::tracks(const DatasetOptions& options, const fs:
   ds.folder_ = dir.string();
   ds.name_ = dir.filename().string();
   files::TrackReadOptions tro;
-  auto seq = files::readTrackFolder(ds.folder_, tro);
+  tro.image_width = options.image_width;
+  tro.image_height = options.image_height;
+  tro.border_tolerance_px = options.border_tolerance_px;
+  auto seq = dataset::readTrackFolder(ds.folder_, tro);
   if (!seq) return seq.status();
+  ds.image_size_source_ = seq->image_size_source;
+  ds.dropped_past_border_ = seq->dropped_past_border;
   std::int64_t first = 0, last = 0;
   SUNVO_RETURN_IF_ERROR(
       range(options, seq->frames.size(), ds.folder_ + "/times.txt", &first, &last));

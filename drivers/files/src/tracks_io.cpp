@@ -1,26 +1,50 @@
 #include "sunvo/files/tracks_io.hpp"
 
-#include "sunvo/files/trajectory_io.hpp"
-
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 
+#include "sunvo/files/trajectory_io.hpp"
+
 namespace sunvo::files {
+namespace {
+constexpr int kMinSize = 16, kMaxSize = 16384;  // px, plausible image sizes
+// With the size from the extent: the principal point is at least this share of the size.
+constexpr double kMinPrincipalShare = 0.35;
+
+std::string formatPx(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.3f", v);
+  return buf;
+}
+}  // namespace
 
 Status TrackReadOptions::validate() const {
-  if (image_width <= 0) return invalidArgument("tracks: image_width must be > 0 px");
-  if (image_height <= 0) return invalidArgument("tracks: image_height must be > 0 px");
+  const bool w = image_width != 0, h = image_height != 0;
+  if (w != h) return invalidArgument("tracks: image_width and image_height: give both or neither");
+  if (w && (image_width < kMinSize || image_width > kMaxSize)) {
+    return invalidArgument("tracks: image_width must be 0 (from the data) or in [16, 16384] px");
+  }
+  if (h && (image_height < kMinSize || image_height > kMaxSize)) {
+    return invalidArgument("tracks: image_height must be 0 (from the data) or in [16, 16384] px");
+  }
+  if (!(border_tolerance_px >= 0.0 && border_tolerance_px <= 50.0)) {
+    return invalidArgument("tracks: border_tolerance_px must be in [0, 50] px");
+  }
   return Status::ok();
 }
 
-Expected<StereoCamera> parseTrackCalib(TextFile& file, int image_width, int image_height) {
+Expected<StereoCamera> parseTrackCalibLine(TextFile& file, bool* has_size) {
   std::string_view line;
   while (file.nextLine(line)) {
     if (isBlank(line)) continue;
     const auto fields = splitFields(line);
-    if (fields.size() != 5) {
-      return file.lineError("expected 5 fields 'fu fv cu cv baseline_m', got " +
-                            std::to_string(fields.size()));
+    if (fields.size() != 5 && fields.size() != 7) {
+      return file.lineError(
+          "expected 5 fields 'fu fv cu cv baseline_m' or 7 with 'width height', "
+          "got " +
+          std::to_string(fields.size()));
     }
     static constexpr const char* kNames[5] = {"fu", "fv", "cu", "cv", "baseline_m"};
     double v[5];
@@ -35,19 +59,40 @@ Expected<StereoCamera> parseTrackCalib(TextFile& file, int image_width, int imag
     cam.cu = v[2];
     cam.cv = v[3];
     cam.baseline_m = v[4];
-    cam.width = image_width;
-    cam.height = image_height;
     if (!(cam.fu > 0.0)) return file.error("fu", "must be > 0");
     if (!(cam.fv > 0.0)) return file.error("fv", "must be > 0");
     if (!(cam.baseline_m > 0.0)) return file.error("baseline_m", "must be > 0");
-    SUNVO_RETURN_IF_ERROR(cam.validate());
+    *has_size = fields.size() == 7;
+    if (*has_size) {
+      static constexpr const char* kSize[2] = {"width", "height"};
+      int* out[2] = {&cam.width, &cam.height};
+      for (int i = 0; i < 2; ++i) {
+        auto x = file.parseInt(fields[static_cast<std::size_t>(5 + i)], kSize[i]);
+        if (!x) return x.status();
+        if (*x < kMinSize || *x > kMaxSize) return file.error(kSize[i], "outside [16, 16384] px");
+        *out[i] = static_cast<int>(*x);
+      }
+      SUNVO_RETURN_IF_ERROR(cam.validate());
+    }
     return cam;
   }
   return parseError(file.path() + ": no calibration line");
 }
 
-Expected<std::vector<FrameFeatures>> parseTracks(TextFile& file, const std::vector<TimeNs>& times,
-                                                 int image_width, int image_height) {
+Expected<StereoCamera> parseTrackCalib(TextFile& file, int image_width, int image_height) {
+  bool has_size = false;
+  auto cam = parseTrackCalibLine(file, &has_size);
+  if (!cam) return cam.status();
+  if (!has_size) {
+    cam->width = image_width;
+    cam->height = image_height;
+    SUNVO_RETURN_IF_ERROR(cam->validate());
+  }
+  return cam;
+}
+
+Expected<ParsedTracks> parseTracks(TextFile& file, const std::vector<TimeNs>& times,
+                                   const TrackBounds& bounds) {
   std::string_view line;
   // Header.
   bool have_header = false;
@@ -66,11 +111,14 @@ Expected<std::vector<FrameFeatures>> parseTracks(TextFile& file, const std::vect
   }
   if (!have_header) return parseError(file.path() + ": empty file, no header");
 
-  std::vector<FrameFeatures> frames(times.size());
+  ParsedTracks out;
+  std::vector<FrameFeatures>& frames = out.frames;
+  frames.resize(times.size());
   for (std::size_t k = 0; k < frames.size(); ++k) {
     frames[k].sequence = k;
     frames[k].time_ns = times[k];
   }
+  const double tol = bounds.border_tolerance_px;
   std::int64_t last_frame = -1;
   while (file.nextLine(line)) {
     if (isBlank(line)) continue;
@@ -94,21 +142,38 @@ Expected<std::vector<FrameFeatures>> parseTracks(TextFile& file, const std::vect
     if (*landmark < 0) return file.error("landmark", "must be >= 0");
     static constexpr const char* kNames[4] = {"uL", "vL", "uR", "vR"};
     double px[4];
+    bool outside = false;  // one of the four coordinates is outside the image, within tolerance
     for (int i = 0; i < 4; ++i) {
-      auto x = file.parseDouble(f[static_cast<std::size_t>(i) + 2], kNames[i]);
+      const auto text = f[static_cast<std::size_t>(i) + 2];
+      auto x = file.parseDouble(text, kNames[i]);
       if (!x) return x.status();
-      const double limit = (i % 2 == 0) ? image_width : image_height;
-      if (*x < 0.0 || *x >= limit) {
-        return file.error(kNames[i], "outside the image [0, " +
-                                         std::to_string(static_cast<int>(limit)) +
-                                         "): " + std::string(f[static_cast<std::size_t>(i) + 2]));
-      }
       px[i] = *x;
+      // Inside: [0, limit); limit 0 = not known yet, no upper border.
+      const int limit = (i % 2 == 0) ? bounds.width : bounds.height;
+      const bool below = *x < 0.0;
+      const bool above = limit > 0 && *x >= limit;
+      if (!below && !above) continue;
+      const double past = below ? -*x : *x - limit;  // px past the border
+      if (past > tol) {
+        const std::string range = limit > 0 ? "[0, " + std::to_string(limit) + ")" : "[0, inf)";
+        return file.error(kNames[i], "outside the image " + range + " by more than the " +
+                                         formatPx(tol) + " px tolerance: " + std::string(text));
+      }
+      outside = true;
+      out.max_outside_px = std::max(out.max_outside_px, past);
+    }
+    if (*frame != last_frame) last_frame = *frame;
+    if (outside) {
+      ++out.dropped_past_border;
+      continue;
     }
     FrameFeatures& ff = frames[static_cast<std::size_t>(*frame)];
-    if (*frame != last_frame) last_frame = *frame;
     for (const auto& o : ff.observations) {
       if (o.landmark_id == *landmark) return file.error("landmark", "duplicate in this frame");
+    }
+    for (int i = 0; i < 4; ++i) {
+      TrackExtent& e = (i % 2 == 0) ? out.u : out.v;
+      if (e.line == 0 || px[i] > e.max_px) e = {px[i], file.lineNumber(), kNames[i]};
     }
     StereoObservation o;
     o.landmark_id = *landmark;
@@ -118,8 +183,37 @@ Expected<std::vector<FrameFeatures>> parseTracks(TextFile& file, const std::vect
     o.v_right = px[3];
     ff.observations.push_back(o);
   }
-  return frames;
+  return out;
 }
+
+Expected<std::vector<FrameFeatures>> parseTracks(TextFile& file, const std::vector<TimeNs>& times,
+                                                 int image_width, int image_height) {
+  if (image_width <= 0 || image_height <= 0) {
+    return invalidArgument("parseTracks: image_width and image_height must be > 0 px");
+  }
+  auto parsed = parseTracks(file, times, TrackBounds{image_width, image_height, 0.0});
+  if (!parsed) return parsed.status();
+  return std::move(parsed->frames);
+}
+
+namespace {
+// The smallest whole-pixel size that holds the extent; it must fit the principal point c.
+Expected<int> sizeFromExtent(const std::string& path, const TrackExtent& e, double c,
+                             const char* axis) {
+  if (e.line == 0) {
+    return parseError(path + ": no observation to take the image " + axis +
+                      " from; state the size in calib.txt or the options");
+  }
+  const double size = std::floor(e.max_px) + 1.0;
+  if (c < kMinPrincipalShare * size || size > kMaxSize) {
+    return parseError(path + ":" + std::to_string(e.line) + ": field '" + e.field +
+                      "': " + formatPx(e.max_px) + " is far outside any image whose principal " +
+                      "point is " + formatPx(c) + " px (the size is not stated; state it in " +
+                      "calib.txt or the options)");
+  }
+  return static_cast<int>(size);
+}
+}  // namespace
 
 Expected<TrackSequence> readTrackFolder(const std::string& folder,
                                         const TrackReadOptions& options) {
@@ -128,9 +222,19 @@ Expected<TrackSequence> readTrackFolder(const std::string& folder,
   {
     auto f = TextFile::open(folder + "/calib.txt");
     if (!f) return f.status();
-    auto cam = parseTrackCalib(*f, options.image_width, options.image_height);
+    bool has_size = false;
+    auto cam = parseTrackCalibLine(*f, &has_size);
     if (!cam) return cam.status();
     seq.camera = *cam;
+    if (options.image_width > 0) {
+      seq.camera.width = options.image_width;
+      seq.camera.height = options.image_height;
+      seq.image_size_source = "the options";
+    } else if (has_size) {
+      seq.image_size_source = "calib.txt";
+    } else {
+      seq.image_size_source = "extent of tracks.csv";
+    }
   }
   std::vector<TimeNs> times;
   {
@@ -141,9 +245,24 @@ Expected<TrackSequence> readTrackFolder(const std::string& folder,
   {
     auto f = TextFile::open(folder + "/tracks.csv");
     if (!f) return f.status();
-    auto fr = parseTracks(*f, times, options.image_width, options.image_height);
-    if (!fr) return fr.status();
-    seq.frames = std::move(*fr);
+    TrackBounds bounds;
+    bounds.width = seq.camera.width;
+    bounds.height = seq.camera.height;
+    bounds.border_tolerance_px = options.border_tolerance_px;
+    auto parsed = parseTracks(*f, times, bounds);
+    if (!parsed) return parsed.status();
+    if (seq.camera.width == 0) {
+      auto w = sizeFromExtent(f->path(), parsed->u, seq.camera.cu, "width");
+      if (!w) return w.status();
+      auto h = sizeFromExtent(f->path(), parsed->v, seq.camera.cv, "height");
+      if (!h) return h.status();
+      seq.camera.width = *w;
+      seq.camera.height = *h;
+    }
+    SUNVO_RETURN_IF_ERROR(seq.camera.validate());
+    seq.frames = std::move(parsed->frames);
+    seq.dropped_past_border = parsed->dropped_past_border;
+    seq.max_outside_px = parsed->max_outside_px;
   }
   {
     auto p = readKittiPoses(folder + "/gt_poses.txt");

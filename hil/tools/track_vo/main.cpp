@@ -11,9 +11,11 @@
 #include <vector>
 
 #include "sunvo/cli/cli.hpp"
+#include "sunvo/dataset/track_folder.hpp"
 #include "sunvo/files/tracks_io.hpp"
 #include "sunvo/files/trajectory_io.hpp"
 #include "sunvo/pipeline/sun_aided_odometry.hpp"
+#include "sunvo/selfcal/stereo_self_calibration.hpp"
 
 namespace {
 
@@ -30,7 +32,7 @@ double percentile(std::vector<double> v, double p) {
 }
 
 struct Args {
-  std::string folder, out_path, log_path;
+  std::string folder, out_path, log_path, selfcal_log_path;
   long max_frames = -1;
 };
 
@@ -71,6 +73,11 @@ int main(int argc, char** argv) {
   app.add_option("--prior-trans-m", win.motion_prior_sigma_trans_m, "motion prior, m");
   app.add_option("--seed", opt.seed, "RANSAC seed");
   app.add_option("--log", args.log_path, "per-frame CSV log");
+  sunvo::selfcal::StereoSelfCalibrationOptions selfcal_opt;  // issue 15: off unless --self-calib
+  app.add_flag("--self-calib", selfcal_opt.enabled,
+               "online stereo self-calibration of the right camera before the odometry");
+  app.add_option("--self-calib-log", args.selfcal_log_path,
+                 "per-frame CSV of the self-calibration (pitch, roll, scale, resets)");
   if (auto code = sunvo::cli::parse(app, argc, argv)) return *code;
   if (app.count("--loss") > 0) {
     win.loss = loss == "none"    ? sunvo::backend::RobustLoss::kNone
@@ -96,8 +103,13 @@ int main(int argc, char** argv) {
       win.sigma_d_px, kLoss[static_cast<int>(win.loss)], win.loss_scale, win.max_num_iterations,
       win.max_solver_time_in_seconds, opt.ransac.min_disparity_px, win.motion_prior_sigma_rot_deg,
       win.motion_prior_sigma_trans_m, static_cast<unsigned long long>(opt.seed));
-  auto seq = sunvo::files::readTrackFolder(args.folder, sunvo::files::TrackReadOptions{});
+  auto seq = sunvo::dataset::readTrackFolder(args.folder, sunvo::files::TrackReadOptions{});
   if (!seq) return sunvo::cli::fail(kProgram, seq.status());
+  std::printf(
+      "tracks: image %dx%d from %s; %zu observations dropped past the border (max %.3f "
+      "px)\n",
+      seq->camera.width, seq->camera.height, seq->image_size_source.c_str(),
+      seq->dropped_past_border, seq->max_outside_px);
   std::size_t n = seq->frames.size();
   if (args.max_frames > 0) n = std::min(n, static_cast<std::size_t>(args.max_frames));
 
@@ -107,6 +119,20 @@ int main(int argc, char** argv) {
       !s.isOk()) {
     return sunvo::cli::fail(kProgram, s);
   }
+  sunvo::selfcal::StereoSelfCalibration selfcal;
+  if (auto s = selfcal.init(selfcal_opt, seq->camera); !s.isOk()) {
+    return sunvo::cli::fail(kProgram, s);
+  }
+  sunvo::FrameFeatures corrected;
+  std::FILE* selfcal_log =
+      args.selfcal_log_path.empty() ? nullptr : std::fopen(args.selfcal_log_path.c_str(), "w");
+  if (!args.selfcal_log_path.empty() && selfcal_log == nullptr) {
+    return sunvo::cli::fail(kProgram, args.selfcal_log_path + ": cannot open for writing");
+  }
+  if (selfcal_log != nullptr) {
+    std::fprintf(selfcal_log, "frame,pitch_mrad,roll_mrad,scale,roll_sigma_mrad,used,reset\n");
+  }
+  std::vector<double> selfcal_ms;
   std::vector<Isometry3> poses;
   poses.reserve(n);
   std::FILE* log = args.log_path.empty() ? nullptr : std::fopen(args.log_path.c_str(), "w");
@@ -123,7 +149,18 @@ int main(int argc, char** argv) {
   long iterations = 0;
   for (std::size_t k = 0; k < n; ++k) {
     const auto t0 = std::chrono::steady_clock::now();
-    auto r = vo.process(seq->frames[k]);
+    const sunvo::FrameFeatures* frame = &seq->frames[k];
+    if (selfcal.enabled()) {
+      const auto rep = selfcal.process(*frame, &corrected);
+      frame = &corrected;
+      selfcal_ms.push_back(
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+      if (selfcal_log != nullptr) {
+        std::fprintf(selfcal_log, "%zu,%.5f,%.5f,%.7f,%.5f,%d,%d\n", k, rep.pitch_mrad,
+                     rep.roll_mrad, rep.scale, rep.roll_sigma_mrad, rep.used, rep.reset ? 1 : 0);
+      }
+    }
+    auto r = vo.process(*frame);
     const double ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     if (!r) {
@@ -149,6 +186,14 @@ int main(int argc, char** argv) {
     iterations += r->solver_iterations;
   }
   if (log != nullptr) std::fclose(log);
+  if (selfcal_log != nullptr) std::fclose(selfcal_log);
+  if (selfcal.enabled()) {
+    std::printf(
+        "self-calibration: right camera pitch %.4f mrad, roll %.4f mrad, vertical scale "
+        "%.6f at the end; %llu resets; %.4f ms/frame median\n",
+        selfcal.state()[0] * 1e3, selfcal.state()[1] * 1e3, selfcal.state()[2],
+        static_cast<unsigned long long>(selfcal.resets()), percentile(selfcal_ms, 50));
+  }
   sunvo::files::Trajectory out_traj;
   out_traj.T_w_c = poses;
   for (std::size_t k = 0; k < poses.size(); ++k) out_traj.t_ns.push_back(seq->frames[k].time_ns);

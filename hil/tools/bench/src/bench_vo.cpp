@@ -10,8 +10,8 @@
 // back end of the second run makes the same association + RANSAC calls: its allocations are
 // RANSAC's, and the window's are the full run's back-end allocations minus those.
 //
-// A third run times the back end alone (vo::StereoTrackOdometry, track mode) on the real feature tracks
-// of KITTI 2011_09_30_drive_0020 (1000 frames, SURF+KLT tracks, ~65 observations per frame).
+// A third run times the back end alone (vo::StereoTrackOdometry, track mode) on the real feature
+// tracks of KITTI 2011_09_30_drive_0020 (1000 frames, SURF+KLT tracks, ~65 observations per frame).
 //
 // Usage: sunvo_bench_vo [--frames=N] [--warmup=N] [--data=DIR] [--tracks=DIR|--tracks=]
 //                       [--cpu=K] [benchmark flags]
@@ -29,10 +29,11 @@
 #include <string>
 #include <vector>
 
-#include "sunvo/runtime/alloc_counter.hpp"
 #include "sunvo/bench/bench_support.hpp"
+#include "sunvo/dataset/track_folder.hpp"
 #include "sunvo/files/tracks_io.hpp"
 #include "sunvo/pipeline/stereo_image_odometry.hpp"
+#include "sunvo/runtime/alloc_counter.hpp"
 
 namespace {
 
@@ -378,7 +379,7 @@ int main(int argc, char** argv) {
       ->Unit(benchmark::kMillisecond)
       ->UseRealTime();
   if (!g_config.tracks.empty()) {
-    auto seq = sunvo::files::readTrackFolder(g_config.tracks, sunvo::files::TrackReadOptions{});
+    auto seq = sunvo::dataset::readTrackFolder(g_config.tracks, sunvo::files::TrackReadOptions{});
     if (!seq) {
       std::fprintf(stderr, "%s\n", seq.status().toString().c_str());
       return 1;

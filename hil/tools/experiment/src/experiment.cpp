@@ -14,6 +14,7 @@ namespace sunvo::experiment {
 Status ExperimentOptions::validate() const {
   SUNVO_RETURN_IF_ERROR(vo.validate());
   SUNVO_RETURN_IF_ERROR(fusion.validate());
+  SUNVO_RETURN_IF_ERROR(self_calibration.validate());
   if (every_n_frames < 1 || every_n_frames > 1000) {
     return invalidArgument("experiment.every_n_frames out of range [1, 1000]");
   }
@@ -46,6 +47,9 @@ Expected<RunResult> runRoute(const Route& route, const std::optional<SunSourceSp
   SUNVO_RETURN_IF_ERROR(
       odometry.init(sao, route.camera, route.T_w_c_gt[0], pipeline::OdometryInput::kFeatures));
 
+  selfcal::StereoSelfCalibration selfcal;
+  SUNVO_RETURN_IF_ERROR(selfcal.init(options.self_calibration, route.camera));
+  FrameFeatures corrected;
   RunResult result;
   result.name = spec ? spec->name : "Pure VO";
   result.T_w_c.reserve(n);
@@ -58,7 +62,12 @@ Expected<RunResult> runRoute(const Route& route, const std::optional<SunSourceSp
       if (m) odometry.addSun({*m, route.sun_w[k]});
     }
     const auto t0 = std::chrono::steady_clock::now();
-    auto r = odometry.process(frame);
+    const FrameFeatures* in = &frame;
+    if (selfcal.enabled()) {
+      selfcal.process(frame, &corrected);
+      in = &corrected;
+    }
+    auto r = odometry.process(*in);
     const auto t1 = std::chrono::steady_clock::now();
     if (!r) return r.status();
     if (r->status == vo::TrackingStatus::kLost) ++result.lost_frames;
@@ -66,6 +75,9 @@ Expected<RunResult> runRoute(const Route& route, const std::optional<SunSourceSp
     result.T_w_c.push_back(r->T_w_c);
   }
   result.gate = odometry.sunCounters();
+  result.selfcal_pitch_mrad = selfcal.state()[0] * 1e3;
+  result.selfcal_roll_mrad = selfcal.state()[1] * 1e3;
+  result.selfcal_resets = selfcal.resets();
   result.median_ms = metrics::percentile(ms, 0.5);
   result.p99_ms = metrics::percentile(ms, 0.99);
   const std::vector<Isometry3> gt(route.T_w_c_gt.begin(),
@@ -151,6 +163,7 @@ Expected<Route> loadRoute(const std::string& spec, const std::string& data_dir,
     return notFound(dopt.path + ": the experiment needs the true sun: " + ds->sunUnknownReason());
   }
   Route route;
+  route.source = ds->describe();
   route.camera = ds->camera();
   route.T_w_c_gt = ds->groundTruth();
   route.times_ns = ds->timesNs();

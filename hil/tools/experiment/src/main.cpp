@@ -58,6 +58,7 @@ int main(int argc, char** argv) {
   bool paper_form = false;
   bool write_poses = false;
   bool fixed_drift = false;
+  bool self_calib = false;
   std::string drift_rule = "persistence";
   CLI::App app{
       "The paper's experiment: pure VO against VO + sun from several sun sources, per route.",
@@ -80,6 +81,8 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.0, 100.0));
   app.add_flag("--paper-form", paper_form, "hold the base attitude fixed, as the paper did");
   app.add_flag("--fixed-drift", fixed_drift, "keep the random walk at --drift-deg");
+  app.add_flag("--self-calib", self_calib,
+               "online stereo self-calibration of the right camera before the odometry");
   app.add_option("--drift-rule", drift_rule, "how the random walk adapts")
       ->check(CLI::IsMember({"persistence", "median", "fixed"}));
   app.add_option("--innovation-gate", innovation_gate,
@@ -106,6 +109,7 @@ int main(int argc, char** argv) {
   sunvo::experiment::ExperimentOptions options;
   options.every_n_frames = every;
   options.max_frames = frames;
+  options.self_calibration.enabled = self_calib;
   // A replay is bounded by solver iterations only: a wall-clock limit would make the result
   // depend on the machine's load. (The onboard program keeps its time budget.)
   options.vo.window.max_solver_time_in_seconds = 60.0;
@@ -137,7 +141,8 @@ int main(int argc, char** argv) {
     sunvo::Expected<Route> route = sunvo::experiment::loadRoute(route_spec, data_dir, sim);
     if (!route)
       return sunvo::cli::fail(kProgram, "route " + route_spec + ": " + route.status().toString());
-    std::fprintf(stderr, "route %s: %zu frames\n", route->name.c_str(), route->frames.size());
+    std::fprintf(stderr, "route %s: %zu frames; %s\n", route->name.c_str(), route->frames.size(),
+                 route->source.c_str());
     std::vector<RunResult> runs;
     for (std::size_t s = 0; s <= sources.size(); ++s) {
       std::optional<sunvo::experiment::SunSourceSpec> spec;
@@ -146,6 +151,13 @@ int main(int argc, char** argv) {
       if (!run) return sunvo::cli::fail(kProgram, route->name + ": " + run.status().toString());
       std::fprintf(stderr, "  %-28s done (%.2f ms/frame median, %d lost)\n", run->name.c_str(),
                    run->median_ms, run->lost_frames);
+      if (self_calib) {
+        std::fprintf(stderr,
+                     "    self-calibration: right camera roll %.4f mrad, pitch %.4f mrad, "
+                     "%llu resets\n",
+                     run->selfcal_roll_mrad, run->selfcal_pitch_mrad,
+                     static_cast<unsigned long long>(run->selfcal_resets));
+      }
       runs.push_back(std::move(*run));
     }
     sunvo::report::ReportInput input;

@@ -22,7 +22,9 @@
 //    `sun_csv`, DIR/sun_cam.csv or DIR/../<NN>_sun_cam.csv. times.txt starts at 0: the UTC time of
 //    its 0 is `odometry_start_utc_ns` (0 when unknown: the times are then only relative).
 //  - kTrackFolder: stereo feature tracks (calib.txt, times.txt, tracks.csv, gt_poses.txt), as
-//    kitti_tracks/<drive>; true sun from `sun_csv` or DIR/sun_cam.csv.
+//    kitti_tracks/<drive>; true sun from `sun_csv` or DIR/sun_cam.csv. The image size from the
+//    options or the data (dataset/track_folder.hpp); observations slightly past the border are
+//    dropped and counted (droppedPastBorder()).
 //  - kTrajectory: a route without frames, for the experiment's simulated tracks: ground truth,
 //    times, true sun and calibration. Either a folder (gt_poses.txt or poses.txt, times.txt,
 //    sun_cam.csv, calib.txt in the track folder's "fu fv cu cv b" form or KITTI odometry P0..P3)
@@ -70,6 +72,10 @@ struct DatasetOptions {
   std::int64_t first_frame = 0;  // index, >= 0: first frame of the range
   std::int64_t last_frame = -1;  // index, >= first_frame; -1 = the last frame
   bool color = false;            // the image source also delivers the colour pair (2/3)
+  // Track folders: px, 0 or [16, 16384], the rectified image size (0 x 0 = from the data).
+  int image_width = 0;
+  int image_height = 0;
+  double border_tolerance_px = 2.0;  // track folders: px, [0, 50]; see files/tracks_io.hpp
 
   Status validate() const;
 };
@@ -123,6 +129,10 @@ class Dataset {
   kitti::KittiSourceOptions imageSourceOptions() const;
   bool hasFeatures() const { return !features_.empty(); }
   const std::vector<FrameFeatures>& features() const { return features_; }  // track folders
+  // Track folders: where the image size came from, and the observations dropped (of the whole
+  // folder) for lying within the tolerance past the border.
+  const std::string& imageSizeSource() const { return image_size_source_; }
+  std::size_t droppedPastBorder() const { return dropped_past_border_; }
 
   // A one-line description: kind, frames, camera, world, what is known.
   std::string describe() const;
@@ -148,6 +158,8 @@ class Dataset {
   std::string sun_reason_;
   bool has_images_ = false;
   std::vector<FrameFeatures> features_;
+  std::string image_size_source_;
+  std::size_t dropped_past_border_ = 0;
 };
 
 // The true sun in camera frames from the world sun and camera poses: sun_c = C_c_w sun_w.

@@ -31,6 +31,10 @@ struct KittiRig {
 // The rig of KITTI odometry sequence "00".."10" (also "0".."10"); nullopt for any other name.
 std::optional<KittiRig> kittiOdometryRig(const std::string& sequence);
 
+// The rig of a KITTI recording day, from a name that starts with it ("2011_10_03",
+// "2011_10_03_drive_0027_sync", a track folder named after its drive); nullopt for other names.
+std::optional<KittiRig> kittiRigOfDay(const std::string& name);
+
 // The KITTI raw drive that KITTI odometry sequence "00".."10" was cut from (the odometry
 // development kit's table), e.g. "05" -> "2011_09_30_drive_0018"; nullopt for any other name.
 std::optional<std::string> kittiOdometryDrive(const std::string& sequence);

@@ -20,6 +20,7 @@
 #include "sunvo/core/features.hpp"
 #include "sunvo/core/geometry.hpp"
 #include "sunvo/metrics/metrics.hpp"
+#include "sunvo/selfcal/stereo_self_calibration.hpp"
 #include "sunvo/sunfusion/simulated_sun_source.hpp"
 #include "sunvo/sunfusion/sun_gate.hpp"
 #include "sunvo/sunfusion/sun_window_term.hpp"
@@ -28,7 +29,8 @@
 namespace sunvo::experiment {
 
 struct Route {
-  std::string name;  // e.g. "2011_09_30_drive_0020 (real tracks)"
+  std::string name;    // e.g. "2011_09_30_drive_0020 (real tracks)"
+  std::string source;  // Dataset::describe() of the data it came from (image size, drops)
   StereoCamera camera;
   std::vector<FrameFeatures> frames;
   std::vector<TimeNs> times_ns;           // frame times (UTC ns when known, else relative)
@@ -48,6 +50,8 @@ struct ExperimentOptions {
   vo::VoOptions vo;
   int every_n_frames = 5;  // a sun measurement every n-th frame, [1, 1000]
   int max_frames = 0;      // 0 = the whole route; else the first max_frames frames, >= 0
+  // Online stereo self-calibration of the tracks before the odometry (off by default).
+  selfcal::StereoSelfCalibrationOptions self_calibration;
   // Gate and world_up are set per source / route. VO starts at the ground-truth first pose, so the
   // attitude is known at frame 0: its prior sigma is 0.1 deg instead of the generic 1 deg.
   sunfusion::SunFusionOptions fusion = [] {
@@ -65,6 +69,10 @@ struct RunResult {
   int lost_frames = 0;
   double median_ms = 0.0;  // VO time per frame (association, RANSAC, window), median
   double p99_ms = 0.0;
+  // Self-calibration (when on): the right camera's roll and pitch at the end, mrad, and resets.
+  double selfcal_roll_mrad = 0.0;
+  double selfcal_pitch_mrad = 0.0;
+  std::uint64_t selfcal_resets = 0;
   metrics::Evaluation evaluation;
 };
 

@@ -1,0 +1,116 @@
+#include "sunvo/selfcal/stereo_self_calibration.hpp"
+
+#include <Eigen/Dense>
+#include <cmath>
+
+namespace sunvo::selfcal {
+namespace {
+constexpr double kDegToRad = M_PI / 180.0;
+
+bool inRange(double x, double lo, double hi) {
+  return x >= lo && x <= hi;
+}
+}  // namespace
+
+Status StereoSelfCalibrationOptions::validate() const {
+  const char* p = "self_calibration.";
+  auto bad = [&](const char* key, const char* range) {
+    return invalidArgument(std::string(p) + key + " outside " + range);
+  };
+  if (!(sigma_px > 0.0 && sigma_px <= 10.0)) return bad("sigma_px", "(0, 10] px");
+  if (!(gate_px > 0.0 && gate_px <= 50.0)) return bad("gate_px", "(0, 50] px");
+  if (!(prior_sigma_deg > 0.0 && prior_sigma_deg <= 10.0)) {
+    return bad("prior_sigma_deg", "(0, 10] deg");
+  }
+  if (!(prior_sigma_scale > 0.0 && prior_sigma_scale <= 0.1)) {
+    return bad("prior_sigma_scale", "(0, 0.1]");
+  }
+  if (!inRange(random_walk_deg, 0.0, 1.0)) return bad("random_walk_deg", "[0, 1] deg");
+  if (!inRange(random_walk_scale, 0.0, 0.01)) return bad("random_walk_scale", "[0, 0.01]");
+  if (!(max_angle_deg > 0.0 && max_angle_deg <= 10.0)) return bad("max_angle_deg", "(0, 10] deg");
+  if (!(max_scale > 0.0 && max_scale <= 0.1)) return bad("max_scale", "(0, 0.1]");
+  if (min_observations < 3 || min_observations > 100000) {
+    return bad("min_observations", "[3, 100000]");
+  }
+  return Status::ok();
+}
+
+Status StereoSelfCalibration::init(const StereoSelfCalibrationOptions& options,
+                                   const StereoCamera& camera) {
+  SUNVO_RETURN_IF_ERROR(options.validate());
+  SUNVO_RETURN_IF_ERROR(camera.validate());
+  options_ = options;
+  camera_ = camera;
+  const double sa = options.prior_sigma_deg * kDegToRad;
+  P0_ = Eigen::Vector3d(sa * sa, sa * sa, options.prior_sigma_scale * options.prior_sigma_scale)
+            .asDiagonal();
+  const double qa = options.random_walk_deg * kDegToRad;
+  Q_ = Eigen::Vector3d(qa * qa, qa * qa, options.random_walk_scale * options.random_walk_scale)
+           .asDiagonal();
+  resets_ = 0;
+  resetState();
+  return Status::ok();
+}
+
+void StereoSelfCalibration::resetState() {
+  x_.setZero();
+  P_ = P0_;
+}
+
+SelfCalibrationReport StereoSelfCalibration::process(const FrameFeatures& in, FrameFeatures* out) {
+  SelfCalibrationReport r;
+  out->time_ns = in.time_ns;
+  out->sequence = in.sequence;
+  out->observations.assign(in.observations.begin(), in.observations.end());
+  if (!options_.enabled) return r;
+
+  // Predict: random walk.
+  P_ += Q_;
+  // Update in information form: x+ = (P^-1 + H^T H / s^2)^-1 (P^-1 x + H^T y / s^2).
+  const double cu = camera_.cu, cv = camera_.cv, fv = camera_.fv;
+  const double w = 1.0 / (options_.sigma_px * options_.sigma_px);
+  Eigen::Matrix3d info = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();
+  for (const StereoObservation& o : in.observations) {
+    const Eigen::Vector3d H(-fv, -(o.u_right - cu), -(o.v_right - cv));
+    const double y = o.v_left - o.v_right;
+    if (!std::isfinite(y) || !H.allFinite() || std::abs(y - H.dot(x_)) > options_.gate_px) {
+      ++r.gated;
+      continue;
+    }
+    info += w * H * H.transpose();
+    b += w * H * y;
+    ++r.used;
+  }
+  if (r.used >= options_.min_observations) {
+    const Eigen::Matrix3d P_inv = P_.inverse();
+    const Eigen::Matrix3d P_new = (P_inv + info).inverse();
+    x_ = P_new * (P_inv * x_ + b);
+    P_ = 0.5 * (P_new + P_new.transpose());
+    r.updated = true;
+  }
+  const double max_angle = options_.max_angle_deg * kDegToRad;
+  if (!x_.allFinite() || !P_.allFinite() || std::abs(x_[0]) > max_angle ||
+      std::abs(x_[1]) > max_angle || std::abs(x_[2]) > options_.max_scale) {
+    resetState();
+    ++resets_;
+    r.reset = true;
+    r.resets = resets_;
+    return r;  // this frame goes on as measured
+  }
+  // Correct the right observations (the inverse of the model above).
+  const double delta = x_[0], theta = x_[1], s = x_[2];
+  for (StereoObservation& o : out->observations) {
+    const double u = o.u_right, v = o.v_right;
+    o.u_right = u + theta * (v - cv);
+    o.v_right = v - fv * delta - theta * (u - cu) - s * (v - cv);
+  }
+  r.pitch_mrad = delta * 1e3;
+  r.roll_mrad = theta * 1e3;
+  r.scale = s;
+  r.roll_sigma_mrad = std::sqrt(P_(1, 1)) * 1e3;
+  r.resets = resets_;
+  return r;
+}
+
+}  // namespace sunvo::selfcal

@@ -1,0 +1,136 @@
+#include "sunvo/selfcal/stereo_self_calibration.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "sunvo/simtracks/simulated_tracks.hpp"
+
+namespace sunvo::selfcal {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+StereoCamera camera() {
+  return {707.0912, 707.0912, 601.8873, 183.1104, 0.5372, 1226, 370};
+}
+
+std::vector<FrameFeatures> tracks(int frames, double noise_px) {
+  std::vector<Isometry3> T_w_c;
+  Isometry3 T = Isometry3::Identity();
+  for (int k = 0; k < frames; ++k) {
+    T_w_c.push_back(T);
+    T.translation().z() += 1.0;
+  }
+  simtracks::SimTrackOptions sim;
+  sim.pixel_noise_px = noise_px;
+  sim.outlier_share = 0.0;
+  auto f = simtracks::simulateTracks(T_w_c, {}, camera(), sim);
+  EXPECT_TRUE(f) << f.status().toString();
+  return f ? *f : std::vector<FrameFeatures>();
+}
+
+// The right camera pitched by delta and rolled by theta (the header's first-order model).
+void miscalibrate(std::vector<FrameFeatures>& frames, double delta, double theta) {
+  const StereoCamera c = camera();
+  for (FrameFeatures& f : frames) {
+    for (StereoObservation& o : f.observations) {
+      const double u = o.u_right, v = o.v_right;
+      o.u_right = u - theta * (v - c.cv);
+      o.v_right = v + c.fv * delta + theta * (u - c.cu);
+    }
+  }
+}
+
+StereoSelfCalibrationOptions on() {
+  StereoSelfCalibrationOptions o;
+  o.enabled = true;
+  return o;
+}
+
+TEST(StereoSelfCalibration, RecoversAnInjectedRightCameraRotation) {
+  auto frames = tracks(200, 0.3);
+  miscalibrate(frames, 0.03 * kDeg, 0.05 * kDeg);
+  StereoSelfCalibration cal;
+  ASSERT_TRUE(cal.init(on(), camera()).isOk());
+  FrameFeatures out;
+  SelfCalibrationReport r;
+  for (std::size_t k = 0; k < 150; ++k) {  // the route's landmarks thin out at its end
+    r = cal.process(frames[k], &out);
+    EXPECT_TRUE(r.updated) << k;
+  }
+  EXPECT_EQ(r.resets, 0u);
+  EXPECT_NEAR(r.roll_mrad, 0.05 * kDeg * 1e3, 0.01 * kDeg * 1e3);  // issue 15: within 0.01 deg
+  EXPECT_NEAR(r.pitch_mrad, 0.03 * kDeg * 1e3, 0.01 * kDeg * 1e3);
+  EXPECT_GT(r.used, 20);
+  EXPECT_LT(r.roll_sigma_mrad, 0.01 * kDeg * 1e3);
+}
+
+TEST(StereoSelfCalibration, CorrectsTheDisparityAndLeavesCleanDataAlone) {
+  const auto clean = tracks(120, 0.0);
+  auto bent = clean;
+  miscalibrate(bent, 0.0, 0.08 * kDeg);
+  StereoSelfCalibration cal, cal_clean;
+  ASSERT_TRUE(cal.init(on(), camera()).isOk());
+  ASSERT_TRUE(cal_clean.init(on(), camera()).isOk());
+  FrameFeatures out, out_clean;
+  double before = 0.0, after = 0.0;
+  for (std::size_t k = 0; k < clean.size(); ++k) {
+    cal.process(bent[k], &out);
+    const auto r = cal_clean.process(clean[k], &out_clean);
+    EXPECT_NEAR(r.roll_mrad, 0.0, 1e-9);
+    ASSERT_EQ(out.observations.size(), clean[k].observations.size());
+    if (k < 100) continue;  // converged
+    for (std::size_t i = 0; i < out.observations.size(); ++i) {
+      before = std::max(
+          before, std::abs(bent[k].observations[i].u_right - clean[k].observations[i].u_right));
+      after =
+          std::max(after, std::abs(out.observations[i].u_right - clean[k].observations[i].u_right));
+      EXPECT_DOUBLE_EQ(out_clean.observations[i].u_right, clean[k].observations[i].u_right);
+    }
+  }
+  EXPECT_GT(before, 0.1);   // the roll bends uR by up to 0.25 px at the top and bottom rows
+  EXPECT_LT(after, 0.005);  // second-order terms of the model
+}
+
+TEST(StereoSelfCalibration, DivergenceIsResetAndCountedNeverNaN) {
+  auto frames = tracks(30, 0.3);
+  miscalibrate(frames, 0.0, 0.05 * kDeg);
+  frames[3].observations[0].v_right = std::numeric_limits<double>::quiet_NaN();
+  StereoSelfCalibrationOptions o = on();
+  o.max_angle_deg = 0.02;  // the true 0.05 deg roll is beyond it: every converged frame resets
+  StereoSelfCalibration cal;
+  ASSERT_TRUE(cal.init(o, camera()).isOk());
+  FrameFeatures out;
+  int resets = 0;
+  for (const FrameFeatures& f : frames) {
+    const auto r = cal.process(f, &out);
+    resets += r.reset;
+    EXPECT_TRUE(cal.state().allFinite());
+    if (r.reset) {
+      // Passed on as measured.
+      EXPECT_DOUBLE_EQ(out.observations[1].u_right, f.observations[1].u_right);
+    }
+  }
+  EXPECT_GT(resets, 0);
+  EXPECT_EQ(cal.resets(), static_cast<std::uint64_t>(resets));
+}
+
+TEST(StereoSelfCalibration, OffPassesThroughAndOptionsAreChecked) {
+  const auto frames = tracks(30, 0.3);
+  StereoSelfCalibration cal;
+  ASSERT_TRUE(cal.init(StereoSelfCalibrationOptions{}, camera()).isOk());
+  FrameFeatures out;
+  const auto r = cal.process(frames[2], &out);
+  EXPECT_FALSE(r.updated);
+  ASSERT_EQ(out.observations.size(), frames[2].observations.size());
+  ASSERT_FALSE(out.observations.empty());
+  EXPECT_DOUBLE_EQ(out.observations[0].v_right, frames[2].observations[0].v_right);
+  StereoSelfCalibrationOptions bad = on();
+  bad.gate_px = 0.0;
+  EXPECT_EQ(cal.init(bad, camera()).message(), "self_calibration.gate_px outside (0, 50] px");
+}
+
+}  // namespace
+}  // namespace sunvo::selfcal
