@@ -83,14 +83,15 @@ RunResult runRig(int exposures, int drop_at, const std::string& sun_provider = "
   // Blobs rather than pixel noise (corners for the front end), stretched to the full range.
   cv::GaussianBlur(texture, texture, cv::Size(0, 0), 2.0);
   cv::normalize(texture, texture, 0, 255, cv::NORM_MINMAX);
-  EXPECT_TRUE(
-      cameras
-          .addCamera({"/dev/video0", kWidth, kHeight, true, true, 0, 0, planeContent(texture, 12)})
-          .isOk());
-  EXPECT_TRUE(
-      cameras
-          .addCamera({"/dev/video1", kWidth, kHeight, true, true, 0, 0, planeContent(texture, 0)})
-          .isOk());
+  // The cameras under the names config/rover.yaml gives them (the package's udev links).
+  EXPECT_TRUE(cameras
+                  .addCamera({"/dev/sunvo-left", kWidth, kHeight, true, true, 0, 0,
+                              planeContent(texture, 12)})
+                  .isOk());
+  EXPECT_TRUE(cameras
+                  .addCamera({"/dev/sunvo-right", kWidth, kHeight, true, true, 0, 0,
+                              planeContent(texture, 0)})
+                  .isOk());
 
   const std::string out = std::string(SUNVO_BINARY_DIR) + "/test_out/rover_devices";
   auto config = loadRoverConfig(
