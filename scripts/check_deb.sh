@@ -23,7 +23,7 @@
 #  5. the udev rules parse: every rule is comma-separated KEY[{attr}] OP "value" with a known key,
 #     match operators on match keys and assignment operators on assignment keys;
 #  6. every path in the installed config (/etc/sunvo/rover.yaml) is a file in the package, a
-#     /dev name one of the udev rules' SYMLINK+= creates, or a folder the unit has systemd make
+#     /dev name one of the udev rules' SYMLINK+= creates, or in a folder the unit has systemd make
 #     (LogsDirectory=, StateDirectory=); none is relative; trigger.gpio_chip matches the KERNEL of
 #     the rules' GPIO rule; a packaged ONNX model has the sha256 its model card (.json) states;
 #  7. for the host's ARCH: every packaged program answers --help with exit 0 and "Usage:", and
@@ -259,6 +259,12 @@ if [ "${has_rover}" -eq 1 ]; then
   for d in $(sed -n 's/^LogsDirectory=//p' "${unit}"); do unit_dirs+=" /var/log/${d}"; done
   # shellcheck disable=SC2013
   for d in $(sed -n 's/^StateDirectory=//p' "${unit}"); do unit_dirs+=" /var/lib/${d}"; done
+  under_unit_dir() {
+    for d in ${unit_dirs}; do
+      case "$1" in "${d}" | "${d}"/*) return 0 ;; esac
+    done
+    return 1
+  }
   paths=0
   while read -r key value; do
     if [ "${key##*.}" = "gpio_chip" ]; then
@@ -292,8 +298,8 @@ if [ "${has_rover}" -eq 1 ]; then
         have="$(sha256sum "${WORK}/root${value}" | cut -d' ' -f1)"
         [ "${want}" = "${have}" ] || bad "${value}: sha256 ${have}, its model card ${card} says '${want}'"
       fi
-    elif [[ " ${unit_dirs} " == *" ${value} "* ]]; then
-      echo "check_deb: rover.yaml ${key}: ${value} <- made by systemd for sunvo.service"
+    elif under_unit_dir "${value}"; then
+      echo "check_deb: rover.yaml ${key}: ${value} <- in a folder systemd makes for sunvo.service"
     else
       bad "rover.yaml ${key}: ${value} is not in the package"
     fi
