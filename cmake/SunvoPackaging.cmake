@@ -3,7 +3,8 @@
 # release). Included at the end of the top-level CMakeLists.txt, after every target exists.
 #
 # Contents: the onboard program sunvo_rover (once firmware_app defines it) and the command-line
-# tools below in /usr/bin; the deployment config in /etc/sunvo (conffile); the systemd unit
+# tools below in /usr/bin; the deployment config in /etc/sunvo (conffile) with what it names (the
+# Sun-CNN model in /usr/share/sunvo, a calibration placeholder in /etc/sunvo); the systemd unit
 # (config/systemd); the udev rules (config/udev, conffile); maintainer scripts (config/debian)
 # that create the sunvo user in the video, gpio and dialout groups. scripts/check_deb.sh checks a
 # built package; docs/deployment.md describes installing it.
@@ -31,6 +32,13 @@ set(_sunvo_conffiles /etc/udev/rules.d/60-sunvo.rules)
 if(EXISTS "${CMAKE_SOURCE_DIR}/config/rover.yaml")
   install(FILES config/rover.yaml DESTINATION /etc/sunvo)
   list(APPEND _sunvo_conffiles /etc/sunvo/rover.yaml)
+  # What rover.yaml names (scripts/check_deb.sh checks every path in it): the Sun-CNN model and
+  # its model card (sun.model), and a placeholder for the stereo calibration
+  # (source.v4l2.calibration), a conffile that stops the program until the administrator puts
+  # the pair's own calibration there; dpkg keeps that file on upgrades.
+  install(FILES config/sun_cnn.onnx config/sun_cnn.json DESTINATION share/sunvo)
+  install(FILES config/debian/calib_cam_to_cam.txt DESTINATION /etc/sunvo)
+  list(APPEND _sunvo_conffiles /etc/sunvo/calib_cam_to_cam.txt)
 endif()
 if(EXISTS "${CMAKE_SOURCE_DIR}/config/rover_replay.yaml")
   install(FILES config/rover_replay.yaml DESTINATION share/sunvo/examples)

@@ -21,7 +21,13 @@
 #     extracted binary), or a key=value parse check where systemd-analyze is missing; its
 #     ExecStart program and --config file are in the package;
 #  5. the udev rules parse: every rule is comma-separated KEY[{attr}] OP "value" with a known key,
-#     match operators on match keys and assignment operators on assignment keys.
+#     match operators on match keys and assignment operators on assignment keys;
+#  6. every path in the installed config (/etc/sunvo/rover.yaml) is a file in the package, a
+#     /dev name one of the udev rules' SYMLINK+= creates, or in a folder the unit has systemd make
+#     (LogsDirectory=, StateDirectory=); none is relative; trigger.gpio_chip matches the KERNEL of
+#     the rules' GPIO rule; a packaged ONNX model has the sha256 its model card (.json) states;
+#  7. for the host's ARCH: every packaged program answers --help with exit 0 and "Usage:", and
+#     --version with exit 0 and "<program> <the package's Version>" (firmware_app/cli).
 set -euo pipefail
 
 if [ $# -lt 3 ] || [ $# -gt 4 ]; then
@@ -73,7 +79,8 @@ conffiles="$(sort "${WORK}/control/conffiles" 2>/dev/null || true)"
   bad "conffiles ($(words "${conffiles}")) differ from the files under /etc ($(words "${etc_files}"))"
 
 # --- 2. contents -------------------------------------------------------------------------------
-programs=(sunvo_replay sunvo_eval sunvo_sun sunvo_geodesy sunvo_kitti_replay sunvo_track_vo)
+programs=(sunvo_replay sunvo_eval sunvo_sun sunvo_geodesy sunvo_kitti_replay sunvo_track_vo
+  sunvo_pose_reader)
 expected=(/lib/systemd/system/sunvo.service /etc/udev/rules.d/60-sunvo.rules
   /usr/share/doc/sunvo/deployment.md)
 has_rover=0
@@ -92,7 +99,7 @@ case "${ARCH}" in
   *) machine="?" ;;
 esac
 for f in "${WORK}"/root/usr/bin/*; do
-  m="$(readelf -h "${f}" 2>/dev/null | sed -n 's/^ *Machine: *//p')"
+  m="$({ readelf -h "${f}" 2>/dev/null || true; } | sed -n 's/^ *Machine: *//p')"
   [ "${m}" = "${machine}" ] || bad "$(basename "${f}"): ELF machine '${m}', not ${ARCH}'s"
 done
 
@@ -128,7 +135,7 @@ version_of() {
 root="${SYSROOT:-/}"
 multiarch="$(case "${ARCH}" in arm64) echo aarch64-linux-gnu ;; amd64) echo x86_64-linux-gnu ;; esac)"
 needed="$(for f in "${WORK}"/root/usr/bin/*; do
-  readelf -d "${f}" | sed -n 's/.*(NEEDED).*\[\(.*\)\]/\1/p'
+  { readelf -d "${f}" 2>/dev/null || true; } | sed -n 's/.*(NEEDED).*\[\(.*\)\]/\1/p'
 done | sort -u)"
 derived="adduser"
 for so in ${needed}; do
@@ -224,6 +231,96 @@ for name in sunvo-left sunvo-right; do
   grep -q "SYMLINK+=\"${name}\"" "${rules}" || bad "60-sunvo.rules names no /dev/${name}"
 done
 grep -q 'KERNEL=="gpiochip' "${rules}" || bad "60-sunvo.rules has no GPIO chip rule"
+
+# --- 6. the installed config's paths ------------------------------------------------------------
+# config_values FILE: "dotted.key value" for every scalar of a block-style YAML file (comments and
+# quotes stripped); flow mappings ({a: 1}) come out whole and contain no path.
+config_values() {
+  awk '
+    /^[[:space:]]*(#|$)/ { next }
+    {
+      match($0, /^ */); indent = RLENGTH; line = substr($0, indent + 1)
+      k = line; if (!sub(/:.*/, "", k)) next
+      v = line; if (!sub(/^[^:]*:[[:space:]]*/, "", v)) next
+      while (depth > 0 && ind[depth] >= indent) depth--
+      depth++; ind[depth] = indent; key[depth] = k
+      sub(/[[:space:]]+#.*$/, "", v); sub(/[[:space:]]+$/, "", v); gsub(/^["\047]|["\047]$/, "", v)
+      if (v == "") next
+      dotted = key[1]; for (i = 2; i <= depth; ++i) dotted = dotted "." key[i]
+      print dotted, v
+    }' "$1"
+}
+if [ "${has_rover}" -eq 1 ]; then
+  cfg_file="${WORK}/root/etc/sunvo/rover.yaml"
+  symlinks="$(sed -n 's/.*SYMLINK+="\([^"]*\)".*/\1/p' "${rules}" | sort -u)"
+  gpio_globs="$(sed -n '/SUBSYSTEM=="gpio"/s/.*KERNEL=="\([^"]*\)".*/\1/p' "${rules}")"
+  unit_dirs=""
+  # shellcheck disable=SC2013  # each directive lists folders separated by spaces
+  for d in $(sed -n 's/^LogsDirectory=//p' "${unit}"); do unit_dirs+=" /var/log/${d}"; done
+  # shellcheck disable=SC2013
+  for d in $(sed -n 's/^StateDirectory=//p' "${unit}"); do unit_dirs+=" /var/lib/${d}"; done
+  under_unit_dir() {
+    for d in ${unit_dirs}; do
+      case "$1" in "${d}" | "${d}"/*) return 0 ;; esac
+    done
+    return 1
+  }
+  paths=0
+  while read -r key value; do
+    if [ "${key##*.}" = "gpio_chip" ]; then
+      chip="${value#/dev/}"
+      matched=0
+      for glob in ${gpio_globs}; do
+        # shellcheck disable=SC2053  # the right side is a udev (shell) glob
+        [[ "${chip}" == ${glob} ]] && matched=1
+      done
+      [ "${matched}" -eq 1 ] || bad "rover.yaml ${key}: ${value} matches no GPIO rule of 60-sunvo.rules ($(words "${gpio_globs}"))"
+      continue
+    fi
+    case "${value}" in
+      */*) ;;
+      *) continue ;;
+    esac
+    paths=$((paths + 1))
+    if [ "${value#/}" = "${value}" ]; then
+      bad "rover.yaml ${key}: ${value} is relative (the service runs in /)"
+    elif [ "${value#/dev/}" != "${value}" ]; then
+      if grep -qxF "${value#/dev/}" <<<"${symlinks}"; then
+        echo "check_deb: rover.yaml ${key}: ${value} <- SYMLINK of 60-sunvo.rules"
+      else
+        bad "rover.yaml ${key}: ${value} is no SYMLINK of 60-sunvo.rules ($(words "${symlinks}"))"
+      fi
+    elif [ -f "${WORK}/root${value}" ]; then
+      echo "check_deb: rover.yaml ${key}: ${value} <- in the package"
+      card="${value%.onnx}.json"
+      if [ "${card}" != "${value}" ] && [ -f "${WORK}/root${card}" ]; then
+        want="$(sed -n 's/.*"model_sha256": *"\([0-9a-f]*\)".*/\1/p' "${WORK}/root${card}")"
+        have="$(sha256sum "${WORK}/root${value}" | cut -d' ' -f1)"
+        [ "${want}" = "${have}" ] || bad "${value}: sha256 ${have}, its model card ${card} says '${want}'"
+      fi
+    elif under_unit_dir "${value}"; then
+      echo "check_deb: rover.yaml ${key}: ${value} <- in a folder systemd makes for sunvo.service"
+    else
+      bad "rover.yaml ${key}: ${value} is not in the package"
+    fi
+  done < <(config_values "${cfg_file}")
+  [ "${paths}" -gt 0 ] || bad "rover.yaml: no path found (config_values cannot read it)"
+fi
+
+# --- 7. the command-line convention ----------------------------------------------------------
+if [ "${ARCH}" = "${HOST_ARCH}" ]; then
+  version="$(field Version)"
+  for f in "${WORK}"/root/usr/bin/*; do
+    p="$(basename "${f}")"
+    if ! out="$("${f}" --help 2>&1)" || ! grep -q "^Usage: ${p}" <<<"${out}"; then
+      bad "${p} --help: no exit 0 with 'Usage: ${p}': ${out:0:200}"
+    fi
+    if ! out="$("${f}" --version 2>&1)" || [ "${out}" != "${p} ${version}" ]; then
+      bad "${p} --version: '${out:0:200}', not '${p} ${version}' with exit 0"
+    fi
+  done
+  echo "check_deb: every program answers --help and --version (${version})"
+fi
 
 size="$(stat -c %s "${DEB}")"
 echo "check_deb: $(basename "${DEB}"): ${size} bytes, Installed-Size $(field Installed-Size) KiB, $(find "${WORK}/root" -type f | wc -l) files, Depends: ${depends}"

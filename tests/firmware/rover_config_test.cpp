@@ -39,7 +39,7 @@ TEST(RoverConfig, TheShippedConfigsLoad) {
   ASSERT_TRUE(rover) << rover.status().toString();
   EXPECT_EQ(rover->source.type, SourceType::kV4l2);
   EXPECT_EQ(rover->trigger.type, TriggerType::kGpio);
-  EXPECT_EQ(rover->sun.model, "/etc/sunvo/sun_cnn.onnx");
+  EXPECT_EQ(rover->sun.model, "/usr/share/sunvo/sun_cnn.onnx");  // installed by the .deb
   auto gray = loadRoverConfig(std::string(SUNVO_SOURCE_DIR) + "/config/rover.yaml",
                               {{"sun.provider", "sun_cnn"}});
   ASSERT_FALSE(gray);
@@ -114,7 +114,9 @@ TEST(RoverConfig, ErrorsNameTheFileTheKeyAndTheLine) {
 
   auto drift = loadRoverConfig(path, {{"estimator.fusion.max_drift_deg_per_frame", "0"}});
   ASSERT_FALSE(drift);
-  EXPECT_NE(drift.status().message().find(path + ": estimator.fusion.min_drift_deg_per_frame / max_drift_deg_per_frame"), std::string::npos)
+  EXPECT_NE(drift.status().message().find(
+                path + ": estimator.fusion.min_drift_deg_per_frame / max_drift_deg_per_frame"),
+            std::string::npos)
       << drift.status().message();
   EXPECT_NE(drift.status().message().find("max_drift_deg_per_frame"), std::string::npos);
 

@@ -72,7 +72,8 @@ TEST(GeodesyCsv, ErrorsNameLineAndField) {
   EXPECT_EQ(s.code(), StatusCode::kParseError);
 }
 
-// The executable: exit 0 on good input, 2 on bad input, errors on stderr.
+// The executable: exit 0 on good input, 1 on bad input, 2 on a bad command line, errors on
+// stderr.
 TEST(GeodesyCli, ExitCodes) {
   const std::string exe = std::string(SUNVO_BINARY_DIR) + "/bin/sunvo_geodesy";
   ASSERT_TRUE(std::filesystem::exists(exe)) << exe;
@@ -97,10 +98,10 @@ TEST(GeodesyCli, ExitCodes) {
   EXPECT_EQ(run(good), 0);
   EXPECT_NE(slurp(out).find("49,8,0,49,8.001,0,73."), std::string::npos) << slurp(out);
   EXPECT_EQ(run("< " + good), 0);  // standard input
-  EXPECT_EQ(run(bad), 2);
+  EXPECT_EQ(run(bad), 1);
   EXPECT_NE(slurp(err).find(bad + ":2: field 'lon': not a number: 'east'"), std::string::npos)
       << slurp(err);
-  EXPECT_EQ(run((dir / "absent.csv").string()), 2);
+  EXPECT_EQ(run((dir / "absent.csv").string()), 1);
   EXPECT_EQ(run("a b"), 2);
   std::filesystem::remove_all(dir);
 }

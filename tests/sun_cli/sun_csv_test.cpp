@@ -129,11 +129,10 @@ TEST(SunCsv, OptionsValidateNamesKey) {
   EXPECT_NE(o.validate().message().find("delta_ut1_s"), std::string::npos);
 }
 
-// The program itself: exit 0 and a CSV file on good input, exit 2 and a line/field message on
-// bad input.
+// The program itself: exit 0 and a CSV file on good input, exit 1 and a line/field message on
+// bad input, exit 2 on a bad command line.
 int runTool(const std::string& args, const std::string& err_path) {
-  const std::string tool =
-      std::string(SUNVO_TOOL_EMULATOR) + SUNVO_BINARY_DIR + "/bin/sunvo_sun";
+  const std::string tool = std::string(SUNVO_TOOL_EMULATOR) + SUNVO_BINARY_DIR + "/bin/sunvo_sun";
   const int rc = std::system((tool + " " + args + " 2>'" + err_path + "'").c_str());
   return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
 }
@@ -161,7 +160,7 @@ TEST(SunCsv, ToolExitCodes) {
   const std::string text = slurp(out);
   EXPECT_NE(text.find("2011-09-30T12:08:26.5Z,49.011,8.416,115,1013.25,15,"), std::string::npos)
       << text;
-  EXPECT_EQ(runTool("-i '" + bad + "' -o '" + out + "'", err), 2);
+  EXPECT_EQ(runTool("-i '" + bad + "' -o '" + out + "'", err), 1);
   EXPECT_NE(slurp(err).find("bad.csv:3: field 'lon_deg'"), std::string::npos) << slurp(err);
   EXPECT_EQ(runTool("--delta-t nope < '" + good + "'", err), 2);
   EXPECT_EQ(runTool("--bogus", err), 2);

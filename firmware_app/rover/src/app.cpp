@@ -191,7 +191,20 @@ Expected<std::unique_ptr<RoverApp>> RoverApp::create(const RoverConfig& config,
     impl->sun =
         std::make_unique<SunStage>(*impl->ctx, impl->attitude, std::move(*provider), world->origin);
   }
-  impl->telemetry = std::make_unique<TelemetryStage>(*impl->ctx, std::move(link));
+  std::unique_ptr<TumPoseLog> pose_log;
+  if (!config.telemetry.pose_log.empty()) {
+    auto opened = TumPoseLog::open(
+        config.telemetry.pose_log,
+        static_cast<std::size_t>(config.telemetry.pose_log_buffer_kb) * 1024,
+        "sunvo_rover started " + formatUtcIso(runtime::utcNowNs()) + ", config " + config.path +
+            "; t tx ty tz qx qy qz qw: frame UTC (s), camera position in the world (ENU, m), "
+            "C_w_c");
+    if (!opened)
+      return Status(opened.status().code(), "telemetry.pose_log: " + opened.status().message());
+    pose_log = std::move(*opened);
+  }
+  impl->telemetry =
+      std::make_unique<TelemetryStage>(*impl->ctx, std::move(link), std::move(pose_log));
   const auto warmup = static_cast<std::uint64_t>(config.realtime.warmup_frames);
   impl->capture->meter().setWarmup(warmup);
   impl->telemetry->meter().setWarmup(warmup);
@@ -331,6 +344,10 @@ std::string RoverApp::summary() const {
           g(h.sun_errors), g(h.sun_late), g(h.sun_accepted), g(h.sun_rejected));
   if (s.telemetry->link() != nullptr)
     o += "  serial: " + s.telemetry->link()->countersText() + "\n";
+  if (const TumPoseLog* log = s.telemetry->poseLog()) {
+    appendf(&o, "  pose log %s: %" PRIu64 " poses, errors %" PRIu64 "\n", log->path().c_str(),
+            log->lines(), g(h.pose_log_errors));
+  }
   if (runtime::allocationProbeInstalled()) {
     auto meter = [&](const char* name, const runtime::AllocationMeter& m) {
       appendf(&o,

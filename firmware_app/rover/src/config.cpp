@@ -337,6 +337,8 @@ Status RoverConfig::validate() const {
       checkOpenLow("telemetry.attitude_sigma_deg", telemetry.attitude_sigma_deg, 0.0, 180.0));
   SUNVO_RETURN_IF_ERROR(
       checkRange("telemetry.full_quality_inliers", telemetry.full_quality_inliers, 1, 100000));
+  SUNVO_RETURN_IF_ERROR(
+      checkRange("telemetry.pose_log_buffer_kb", telemetry.pose_log_buffer_kb, 1, 65536));
   SUNVO_RETURN_IF_ERROR(checkRange("rt.heap_reserve_mb", rt.heap_reserve_mb, 0, 4096));
   SUNVO_RETURN_IF_ERROR(rt.threads.capture.validate("rt.threads.capture"));
   SUNVO_RETURN_IF_ERROR(rt.threads.estimator.validate("rt.threads.estimator"));

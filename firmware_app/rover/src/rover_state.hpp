@@ -70,6 +70,7 @@ struct Health {
   std::atomic<std::uint64_t> deadline_misses{0};
   std::atomic<std::uint64_t> heartbeats{0};
   std::atomic<std::uint64_t> link_errors{0};
+  std::atomic<std::uint64_t> pose_log_errors{0};  // telemetry.pose_log: failed writes, lost lines
 };
 
 // The rings between the stages (drop-oldest: a stale frame or pose is of no use), their event

@@ -11,6 +11,7 @@
 #include "sunvo/pipeline/sun_aided_odometry.hpp"
 #include "sunvo/rover/config.hpp"
 #include "sunvo/rover/pose_link.hpp"
+#include "sunvo/rover/pose_log.hpp"
 #include "sunvo/rover/sources.hpp"
 #include "sunvo/rover/sun_provider.hpp"
 #include "sunvo/runtime/allocation_meter.hpp"
@@ -100,18 +101,22 @@ class SunStage {
 };
 
 // Each pose -> the link (MAVLink ODOMETRY), HEARTBEAT at heartbeat_hz; the time the frame's last
-// byte left is its publish stamp; trigger -> last byte above the deadline is a miss.
+// byte left is its publish stamp; trigger -> last byte above the deadline is a miss. With a pose
+// log (telemetry.pose_log), each pose also goes there, flushed about once a second and at the end.
 class TelemetryStage {
  public:
-  TelemetryStage(StageContext& ctx, std::unique_ptr<PoseLink> link)
-      : ctx_(ctx), link_(std::move(link)) {}
+  TelemetryStage(StageContext& ctx, std::unique_ptr<PoseLink> link,
+                 std::unique_ptr<TumPoseLog> pose_log = nullptr)
+      : ctx_(ctx), link_(std::move(link)), pose_log_(std::move(pose_log)) {}
   void run();
   const PoseLink* link() const { return link_.get(); }
+  const TumPoseLog* poseLog() const { return pose_log_.get(); }
   runtime::AllocationMeter& meter() { return meter_; }
 
  private:
   StageContext& ctx_;
   std::unique_ptr<PoseLink> link_;
+  std::unique_ptr<TumPoseLog> pose_log_;
   runtime::AllocationMeter meter_;
 };
 

@@ -15,6 +15,11 @@ void TelemetryStage::run() {
   std::uint64_t pending_seq = 0;
   TimeNs pending_trigger = 0;
   TimeNs drain_until = 0;  // after the estimator finished: flush for at most this long
+  constexpr TimeNs kLogFlushPeriodNs = 1'000'000'000;
+  TimeNs next_log_flush = runtime::monotonicNs() + kLogFlushPeriodNs;
+  auto log_error = [&](const Status& s) {
+    if (!s.isOk()) health.pose_log_errors.fetch_add(1, std::memory_order_relaxed);
+  };
   auto complete = [&](TimeNs last_byte) {
     ctx_.profiler.stamp(pending_seq, runtime::Stamp::kLastByte, last_byte);
     if (last_byte - pending_trigger > deadline_ns) {
@@ -38,8 +43,13 @@ void TelemetryStage::run() {
         health.link_errors.fetch_add(1, std::memory_order_relaxed);
       }
       if (!link_) complete(runtime::monotonicNs());
+      if (pose_log_) log_error(pose_log_->append(pose));  // after the link: off its latency
     }
     const TimeNs now = runtime::monotonicNs();
+    if (pose_log_ && now >= next_log_flush) {
+      log_error(pose_log_->flush());
+      next_log_flush = now + kLogFlushPeriodNs;
+    }
     if (link_) {
       if (!link_->service(now).isOk()) health.link_errors.fetch_add(1, std::memory_order_relaxed);
       if (pending && link_->drained()) complete(link_->lastByteWrittenNs());
@@ -62,6 +72,7 @@ void TelemetryStage::run() {
     sleep_ns = std::clamp<TimeNs>(sleep_ns, 100'000, 100'000'000);
     ch.poses_ev.wait(key, sleep_ns);
   }
+  if (pose_log_) log_error(pose_log_->flush());
   ch.telemetry_done.store(true, std::memory_order_release);
 }
 

@@ -3,8 +3,9 @@
 // OpenCV calls that could spawn threads). Prints per-stage median/p95/p99, heap allocations per
 // frame inside process() after a warm-up, and the resident set size.
 //
-// Usage: sunvo_bench_frontend [--frames=N] [--warmup=N] [--data=DIR] [--cpu=K] [benchmark flags]
-//   --cpu=K pins the process to CPU K (sched_setaffinity) before anything runs.
+// Usage: sunvo_bench_frontend [--frames=N] [--warmup=N] [--data=DIR] [--cpu=K] [--benchmark_*]
+//   --cpu=K pins the process to CPU K (sched_setaffinity) before anything runs; --benchmark_*
+//   options go to Google Benchmark. Options: sunvo_bench_frontend --help.
 
 #include <benchmark/benchmark.h>
 
@@ -17,9 +18,11 @@
 #include <string>
 #include <vector>
 
-#include "sunvo/runtime/alloc_counter.hpp"
 #include "sunvo/bench/bench_support.hpp"
+#include "sunvo/bench/benchmark_cli.hpp"
+#include "sunvo/cli/cli.hpp"
 #include "sunvo/frontend/stereo_frontend.hpp"
+#include "sunvo/runtime/alloc_counter.hpp"
 
 namespace {
 
@@ -169,31 +172,21 @@ void printSummary() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  constexpr const char* kProgram = "sunvo_bench_frontend";
   cv::setNumThreads(0);
-  // Own flags first; the rest goes to Google Benchmark.
-  std::vector<char*> rest;
-  for (int i = 0; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (sunvo::bench::parseBenchFlag(a, g_config)) {
-      continue;
-    } else {
-      rest.push_back(argv[i]);
-    }
-  }
+  CLI::App app{"Stereo front-end time and heap allocations per frame on real KITTI frames.",
+               kProgram};
+  sunvo::bench::addBenchOptions(app, g_config);
+  if (auto code = sunvo::bench::parseWithBenchmarkFlags(app, argc, argv)) return *code;
   auto sample = sunvo::bench::prepareBenchmark(g_config, sunvo::runtime::allocCounterActive());
-  if (!sample) {
-    std::fprintf(stderr, "%s\n", sample.status().toString().c_str());
-    return 1;
-  }
+  if (!sample) return sunvo::cli::fail(kProgram, sample.status());
   g_sample = std::move(*sample);
   benchmark::RegisterBenchmark("frontend/kitti00_first_frames_pingpong", benchFrontend)
       ->Iterations(g_config.frames)
       ->Unit(benchmark::kMillisecond)
       ->UseRealTime();
-  int rest_argc = static_cast<int>(rest.size());
-  benchmark::Initialize(&rest_argc, rest.data());
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
   printSummary();
-  return g_results.ok ? 0 : 1;
+  return g_results.ok ? sunvo::cli::kExitOk : sunvo::cli::kExitFailure;
 }

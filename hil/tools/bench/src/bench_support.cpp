@@ -3,6 +3,7 @@
 #include <malloc.h>
 #include <sched.h>
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -28,19 +29,13 @@ Expected<KittiFrames> loadKittiOdometryFrames(const std::string& dir, TimeNs sta
   return out;
 }
 
-bool parseBenchFlag(const std::string& a, BenchConfig& config) {
-  if (a.rfind("--frames=", 0) == 0) {
-    config.frames = std::max(1, std::atoi(a.c_str() + 9));
-  } else if (a.rfind("--warmup=", 0) == 0) {
-    config.warmup = std::max(0, std::atoi(a.c_str() + 9));
-  } else if (a.rfind("--cpu=", 0) == 0) {
-    config.cpu = std::atoi(a.c_str() + 6);
-  } else if (a.rfind("--data=", 0) == 0) {
-    config.data = a.substr(7);
-  } else {
-    return false;
-  }
-  return true;
+void addBenchOptions(CLI::App& app, BenchConfig& config) {
+  app.add_option("--frames", config.frames, "timed frames")->check(CLI::Range(1, 100000000));
+  app.add_option("--warmup", config.warmup, "frames before timing")
+      ->check(CLI::Range(0, 100000000));
+  app.add_option("--data", config.data, "KITTI odometry sequence folder (calib.txt, image_0/1)");
+  app.add_option("--cpu", config.cpu, "pin the process to this CPU (-1: no pinning)")
+      ->check(CLI::Range(-1, 4095));
 }
 
 Expected<KittiFrames> prepareBenchmark(const BenchConfig& config, bool alloc_counter_active) {

@@ -14,9 +14,10 @@
 // tracks of KITTI 2011_09_30_drive_0020 (1000 frames, SURF+KLT tracks, ~65 observations per frame).
 //
 // Usage: sunvo_bench_vo [--frames=N] [--warmup=N] [--data=DIR] [--tracks=DIR|--tracks=]
-//                       [--cpu=K] [benchmark flags]
+//                       [--cpu=K] [--benchmark_*]
 //   --cpu=K pins the process to CPU K (sched_setaffinity) before anything runs;
-//   --tracks= (empty) skips the track-mode run.
+//   --tracks= (empty) skips the track-mode run; --benchmark_* options go to Google Benchmark.
+//   Options: sunvo_bench_vo --help.
 
 #include <benchmark/benchmark.h>
 
@@ -30,6 +31,8 @@
 #include <vector>
 
 #include "sunvo/bench/bench_support.hpp"
+#include "sunvo/bench/benchmark_cli.hpp"
+#include "sunvo/cli/cli.hpp"
 #include "sunvo/dataset/track_folder.hpp"
 #include "sunvo/files/tracks_io.hpp"
 #include "sunvo/pipeline/stereo_image_odometry.hpp"
@@ -350,23 +353,19 @@ void printSummary() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  constexpr const char* kProgram = "sunvo_bench_vo";
   cv::setNumThreads(0);
-  std::vector<char*> rest;
-  for (int i = 0; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (sunvo::bench::parseBenchFlag(a, g_config)) {
-      continue;
-    } else if (a.rfind("--tracks=", 0) == 0) {
-      g_config.tracks = a.substr(9);
-    } else {
-      rest.push_back(argv[i]);
-    }
-  }
+  CLI::App app{
+      "Image VO (front end, RANSAC, Ceres window) time and heap allocations per frame on real "
+      "KITTI frames, and the back end alone on recorded feature tracks.",
+      kProgram};
+  sunvo::bench::addBenchOptions(app, g_config);
+  app.add_option("--tracks", g_config.tracks,
+                 "feature-track folder of the back-end-only run (--tracks= skips it)")
+      ->expected(0, 1);
+  if (auto code = sunvo::bench::parseWithBenchmarkFlags(app, argc, argv)) return *code;
   auto data = sunvo::bench::prepareBenchmark(g_config, sunvo::runtime::allocCounterActive());
-  if (!data) {
-    std::fprintf(stderr, "%s\n", data.status().toString().c_str());
-    return 1;
-  }
+  if (!data) return sunvo::cli::fail(kProgram, data.status());
   g_data = std::move(*data);
   g_full.name = "full";
   g_ransac_only.name = "ransac_only";
@@ -380,10 +379,7 @@ int main(int argc, char** argv) {
       ->UseRealTime();
   if (!g_config.tracks.empty()) {
     auto seq = sunvo::dataset::readTrackFolder(g_config.tracks, sunvo::files::TrackReadOptions{});
-    if (!seq) {
-      std::fprintf(stderr, "%s\n", seq.status().toString().c_str());
-      return 1;
-    }
+    if (!seq) return sunvo::cli::fail(kProgram, seq.status());
     g_track_seq = std::move(*seq);
     g_tracks.name = "tracks";
     benchmark::RegisterBenchmark("vo/backend_only/kitti_tracks_0020", benchTracks)
@@ -391,10 +387,8 @@ int main(int argc, char** argv) {
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();
   }
-  int rest_argc = static_cast<int>(rest.size());
-  benchmark::Initialize(&rest_argc, rest.data());
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
   printSummary();
-  return g_full.ok ? 0 : 1;
+  return g_full.ok ? sunvo::cli::kExitOk : sunvo::cli::kExitFailure;
 }

@@ -1,4 +1,4 @@
-// sunvo_bench_v4l2 [--frames=N] [--width=W] [--height=H] [--cpu=K]
+// sunvo_bench_v4l2 [--frames=N] [--width=W] [--height=H] [--cpu=K] (sunvo_bench_v4l2 --help)
 // Per-frame time of V4l2StereoSource::next() (dequeue, pairing, GREY copy or YUYV conversion,
 // requeue) for every layout and pixel format, through the emulated V4L2 devices; the emulated
 // kernel's own work (filling the buffers in trigger()) is outside the timed region. Also counts
@@ -8,15 +8,13 @@
 
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
-#include <cstring>
-#include <string>
 #include <vector>
 
-#include "sunvo/runtime/alloc_counter.hpp"
 #include "sunvo/bench/bench_support.hpp"
+#include "sunvo/cli/cli.hpp"
 #include "sunvo/emulated/emulated_v4l2.hpp"
 #include "sunvo/metrics/metrics.hpp"
+#include "sunvo/runtime/alloc_counter.hpp"
 #include "sunvo/v4l2/stereo_source.hpp"
 
 namespace {
@@ -93,33 +91,30 @@ int runCase(V4l2Layout layout, V4l2PixelFormat format, int width, int height, in
   return 0;
 }
 
-int intFlag(int argc, char** argv, const char* name, int fallback) {
-  const std::size_t n = std::strlen(name);
-  for (int i = 1; i < argc; ++i) {
-    if (std::strncmp(argv[i], name, n) == 0 && argv[i][n] == '=') return std::atoi(argv[i] + n + 1);
-  }
-  return fallback;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
-  const int frames = intFlag(argc, argv, "--frames", 500);
-  const int width = intFlag(argc, argv, "--width", 1242);
-  const int height = intFlag(argc, argv, "--height", 375);
-  const int cpu = intFlag(argc, argv, "--cpu", -1);
-  if (frames < 1 || width < 16 || height < 16) {
-    std::fprintf(stderr,
-                 "usage: sunvo_bench_v4l2 [--frames=N] [--width=W] [--height=H] [--cpu=K]\n");
-    return 2;
-  }
+  constexpr const char* kProgram = "sunvo_bench_v4l2";
+  int frames = 500;
+  int width = 1242;
+  int height = 375;
+  int cpu = -1;
+  CLI::App app{
+      "V4l2StereoSource::next() time and heap allocations per frame through the emulated "
+      "V4L2 devices, for every layout and pixel format.",
+      kProgram};
+  app.add_option("--frames", frames, "timed frames per case")->check(CLI::Range(1, 100000000));
+  app.add_option("--width", width, "image width per eye, px")->check(CLI::Range(16, 16384));
+  app.add_option("--height", height, "image height, px")->check(CLI::Range(16, 16384));
+  app.add_option("--cpu", cpu, "pin the process to this CPU (-1: no pinning)")
+      ->check(CLI::Range(-1, 4095));
+  if (auto code = sunvo::cli::parse(app, argc, argv)) return *code;
   if (!sunvo::runtime::allocCounterActive()) {
-    std::fprintf(stderr, "allocation counter not active\n");
-    return 1;
+    return sunvo::cli::fail(kProgram, "allocation counter not active");
   }
   if (cpu >= 0) {
     const sunvo::Status s = sunvo::bench::pinToCpu(cpu);
-    if (!s.isOk()) std::fprintf(stderr, "warning: %s\n", s.toString().c_str());
+    if (!s.isOk()) std::fprintf(stderr, "%s: warning: %s\n", kProgram, s.toString().c_str());
   }
   std::printf(
       "V4l2StereoSource::next() per frame, %d frames per case (after one warm-up frame), "

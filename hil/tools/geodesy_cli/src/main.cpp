@@ -1,35 +1,25 @@
 // sunvo_geodesy: geodetic -> local ENU for a CSV table.
 //   sunvo_geodesy [INPUT.csv | -]      (default: standard input), table on standard output.
-// Exit codes: 0 ok, 2 bad input or usage, 1 output failure.
+// Exit codes (firmware_app/cli): 0 ok, 2 a bad command line, 1 an unreadable or malformed input
+// (the message names file, line and field) or an output failure.
 #include <cstdio>
 #include <iostream>
 #include <sstream>
 #include <string>
 
+#include "sunvo/cli/cli.hpp"
 #include "sunvo/geodesy_cli/geodesy_csv.hpp"
 
-namespace {
-
-constexpr const char* kUsage =
-    "usage: sunvo_geodesy [INPUT.csv | -]\n"
-    "  INPUT: header 'origin_lat,origin_lon,origin_alt,lat,lon,alt' (deg, deg, m above WGS84),\n"
-    "  one point per row. Writes the rows with east,north,up (m) appended to standard output.\n";
-
-}  // namespace
-
 int main(int argc, char** argv) {
+  constexpr const char* kProgram = "sunvo_geodesy";
   std::string path = "-";
-  if (argc > 2) {
-    std::fputs(kUsage, stderr);
-    return 2;
-  }
-  if (argc == 2) {
-    path = argv[1];
-    if (path == "-h" || path == "--help") {
-      std::fputs(kUsage, stdout);
-      return 0;
-    }
-  }
+  CLI::App app{
+      "Geodetic -> local East-North-Up for a CSV table. Input header "
+      "'origin_lat,origin_lon,origin_alt,lat,lon,alt' (deg, deg, m above WGS84), one point per "
+      "row; writes the rows with east,north,up (m) appended to standard output.",
+      kProgram};
+  app.add_option("input", path, "the CSV table; - or none: standard input");
+  if (auto code = sunvo::cli::parse(app, argc, argv)) return *code;
   auto read_stdin = [] {
     std::ostringstream ss;
     ss << std::cin.rdbuf();
@@ -38,19 +28,10 @@ int main(int argc, char** argv) {
   sunvo::Expected<sunvo::files::TextFile> in =
       path == "-" ? sunvo::Expected<sunvo::files::TextFile>(read_stdin())
                   : sunvo::files::TextFile::open(path);
-  if (!in) {
-    std::fprintf(stderr, "sunvo_geodesy: %s\n", in.status().message().c_str());
-    return 2;
-  }
+  if (!in) return sunvo::cli::fail(kProgram, in.status().message());
   const sunvo::Status s = sunvo::geodesy_cli::convertGeodesyCsv(*in, std::cout);
   std::cout.flush();
-  if (!s) {
-    std::fprintf(stderr, "sunvo_geodesy: %s\n", s.message().c_str());
-    return s.code() == sunvo::StatusCode::kIoError ? 1 : 2;
-  }
-  if (!std::cout) {
-    std::fputs("sunvo_geodesy: write to standard output failed\n", stderr);
-    return 1;
-  }
-  return 0;
+  if (!s) return sunvo::cli::fail(kProgram, s.message());
+  if (!std::cout) return sunvo::cli::fail(kProgram, "write to standard output failed");
+  return sunvo::cli::kExitOk;
 }

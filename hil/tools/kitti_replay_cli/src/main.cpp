@@ -3,84 +3,62 @@
 //                      [--start-utc "YYYY-MM-DD HH:MM:SS[.f]"] [--color] [--paced]
 //                      [--first N] [--last N] [--repeat R] [--list]
 // --start-utc is the UTC time of times.txt's 0 (odometry layout); --utc-offset-s the zone offset of
-// raw timestamps. Exit codes: 0 ok, 2 bad arguments or bad input.
+// raw timestamps. Exit codes (firmware_app/cli): 0 ok, 2 a bad command line, 1 a recording that
+// cannot be read.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
 #include <string>
-#include <string_view>
 #include <vector>
 
+#include "sunvo/cli/cli.hpp"
 #include "sunvo/kitti/stereo_source.hpp"
 
-namespace {
-
-constexpr const char* kUsage =
-    "usage: sunvo_kitti_replay --root DIR [--layout auto|raw|odometry] [--utc-offset-s S]\n"
-    "         [--start-utc \"YYYY-MM-DD HH:MM:SS[.f]\"] [--color] [--paced] [--first N]\n"
-    "         [--last N] [--repeat R] [--list]\n";
-
-bool parseInt64(const char* text, std::int64_t& out) {
-  char* end = nullptr;
-  const long long v = std::strtoll(text, &end, 10);
-  if (end == text || *end != '\0') return false;
-  out = v;
-  return true;
-}
-
-}  // namespace
-
 int main(int argc, char** argv) {
+  constexpr const char* kProgram = "sunvo_kitti_replay";
   sunvo::kitti::KittiSourceOptions options;
   std::int64_t repeat = 1;
+  std::int64_t utc_offset_s = 0;
+  std::string layout = "auto";
+  std::string start_utc;
   bool list = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string_view arg = argv[i];
-    const bool has_value = i + 1 < argc;
-    std::int64_t v = 0;
-    if (arg == "--root" && has_value) {
-      options.root = argv[++i];
-    } else if (arg == "--layout" && has_value) {
-      const std::string_view l = argv[++i];
-      if (l == "auto") {
-        options.layout = sunvo::kitti::KittiLayout::kAuto;
-      } else if (l == "raw") {
-        options.layout = sunvo::kitti::KittiLayout::kRaw;
-      } else if (l == "odometry") {
-        options.layout = sunvo::kitti::KittiLayout::kOdometry;
-      } else {
-        std::fprintf(stderr, "--layout: '%s' is not auto, raw or odometry\n", argv[i]);
-        return 2;
-      }
-    } else if (arg == "--utc-offset-s" && has_value && parseInt64(argv[i + 1], v)) {
-      options.utc_offset_s = v;
-      ++i;
-    } else if (arg == "--start-utc" && has_value) {
-      auto t = sunvo::parseCivilTime(argv[++i], 0);
-      if (!t) {
-        std::fprintf(stderr, "--start-utc: %s\n", t.status().message().c_str());
-        return 2;
-      }
-      options.odometry_start_time_ns = *t;
-    } else if (arg == "--first" && has_value && parseInt64(argv[i + 1], v)) {
-      options.first_frame = v;
-      ++i;
-    } else if (arg == "--last" && has_value && parseInt64(argv[i + 1], v)) {
-      options.last_frame = v;
-      ++i;
-    } else if (arg == "--repeat" && has_value && parseInt64(argv[i + 1], v) && v >= 1) {
-      repeat = v;
-      ++i;
-    } else if (arg == "--color") {
-      options.use_color = true;
-    } else if (arg == "--paced") {
-      options.pacing = sunvo::kitti::Pacing::kRecordedRate;
-    } else if (arg == "--list") {
-      list = true;
-    } else {
-      std::fprintf(stderr, "bad argument '%s'\n%s", argv[i], kUsage);
-      return 2;
-    }
+  bool paced = false;
+  CLI::App app{
+      "Reads a KITTI recording (raw drive or odometry sequence) through the file-backed "
+      "stereo source; lists the frames and measures the read rate.",
+      kProgram};
+  app.add_option("--root", options.root, "the drive or sequence folder")->required();
+  app.add_option("--layout", layout, "folder layout (auto: by image_00/ or image_0/)")
+      ->check(CLI::IsMember({"auto", "raw", "odometry"}));
+  app.add_option("--utc-offset-s", utc_offset_s, "zone offset of raw timestamps to UTC, s")
+      ->check(CLI::Range(-50400L, 50400L));
+  app.add_option("--start-utc", start_utc,
+                 "UTC time of times.txt's 0 (odometry layout), \"YYYY-MM-DD HH:MM:SS[.f]\"")
+      ->check(CLI::Validator(
+          [](std::string& text) {
+            auto t = sunvo::parseCivilTime(text, 0);
+            return t ? std::string() : t.status().message();
+          },
+          "UTC"));
+  app.add_flag("--color", options.use_color, "read the colour cameras (image_02/03)");
+  app.add_flag("--paced", paced, "deliver frames at the recorded rate");
+  app.add_option("--first", options.first_frame, "first frame index")
+      ->check(CLI::Range(0L, 100000000L));
+  app.add_option("--last", options.last_frame, "last frame index, inclusive (-1: the last)")
+      ->check(CLI::Range(-1L, 100000000L));
+  app.add_option("--repeat", repeat, "read the recording this many times")
+      ->check(CLI::Range(1L, 1000000L));
+  app.add_flag("--list", list, "print index, UTC time and size of every frame");
+  if (auto code = sunvo::cli::parse(app, argc, argv)) return *code;
+  options.layout = layout == "raw"        ? sunvo::kitti::KittiLayout::kRaw
+                   : layout == "odometry" ? sunvo::kitti::KittiLayout::kOdometry
+                                          : sunvo::kitti::KittiLayout::kAuto;
+  if (app.count("--utc-offset-s") > 0) options.utc_offset_s = utc_offset_s;
+  if (!start_utc.empty()) options.odometry_start_time_ns = *sunvo::parseCivilTime(start_utc, 0);
+  if (paced) options.pacing = sunvo::kitti::Pacing::kRecordedRate;
+  if (const sunvo::Status s = options.validate(); !s.isOk()) {
+    std::fprintf(stderr, "%s: %s\n", kProgram, s.message().c_str());
+    return sunvo::cli::kExitUsage;
   }
 
   using Clock = std::chrono::steady_clock;
@@ -91,10 +69,7 @@ int main(int argc, char** argv) {
   for (std::int64_t r = 0; r < repeat; ++r) {
     const auto t_open = Clock::now();
     auto source = sunvo::kitti::KittiStereoSource::open(options);
-    if (!source) {
-      std::fprintf(stderr, "sunvo_kitti_replay: %s\n", source.status().message().c_str());
-      return 2;
-    }
+    if (!source) return sunvo::cli::fail(kProgram, source.status().message());
     const auto t_start = Clock::now();
     open_ms.push_back(std::chrono::duration<double, std::milli>(t_start - t_open).count());
     std::int64_t n = 0;
@@ -102,8 +77,7 @@ int main(int argc, char** argv) {
       const sunvo::Status s = source->next(frame);
       if (!s) {
         if (source->finished()) break;
-        std::fprintf(stderr, "sunvo_kitti_replay: %s\n", s.message().c_str());
-        return 2;
+        return sunvo::cli::fail(kProgram, s.message());
       }
       if (list && r == 0) {
         std::printf("%llu %s %dx%d\n", static_cast<unsigned long long>(frame.sequence),
@@ -116,6 +90,7 @@ int main(int argc, char** argv) {
     rates.push_back(static_cast<double>(n) / s);
     frames_per_run = n;
   }
+  if (rates.empty()) return sunvo::cli::fail(kProgram, "no run");  // --repeat >= 1
   double mean = 0.0, lo = rates.front(), hi = rates.front(), open_mean = 0.0;
   for (double x : rates) {
     mean += x / static_cast<double>(rates.size());
@@ -128,5 +103,5 @@ int main(int argc, char** argv) {
       "mean\n",
       static_cast<long long>(frames_per_run), static_cast<long long>(repeat), mean, lo, hi,
       open_mean);
-  return 0;
+  return sunvo::cli::kExitOk;
 }

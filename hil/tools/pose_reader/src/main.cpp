@@ -13,7 +13,8 @@
 //    times: trigger -> last byte written (the program's own stamp) and trigger -> byte received
 //    here (both CLOCK_MONOTONIC on this machine);
 //  - writes a JSON report and exits 0 only when every pose arrived once with good CRCs, the
-//    program exited 0 after SIGTERM and printed its summary, and the accuracy bounds hold.
+//    program exited 0 after SIGTERM and printed its summary, and the accuracy bounds hold; 1
+//    otherwise, 2 for a bad command line (firmware_app/cli).
 
 #include <fcntl.h>
 #include <poll.h>
@@ -34,6 +35,7 @@
 #include <string>
 #include <vector>
 
+#include "sunvo/cli/cli.hpp"
 #include "sunvo/core/geometry.hpp"
 #include "sunvo/dataset/dataset.hpp"
 #include "sunvo/files/text_file.hpp"
@@ -69,51 +71,6 @@ struct Received {
   TimeNs recv_mono_ns = 0;
 };
 
-void usage() {
-  std::fprintf(stderr,
-               "usage: sunvo_pose_reader --drive DIR --frames N [--timeout-s S] [--json FILE]\n"
-               "         [--child-log FILE] [--latency-csv FILE] [--max-final-drift-m M]\n"
-               "         [--max-rot-armse-rad R] [--utc-offset-s S] -- COMMAND ... {pty} ...\n");
-}
-
-bool parse(int argc, char** argv, Options* o) {
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto value = [&](std::string* out) {
-      if (i + 1 >= argc) return false;
-      *out = argv[++i];
-      return true;
-    };
-    std::string v;
-    if (a == "--") {
-      for (++i; i < argc; ++i) o->command.emplace_back(argv[i]);
-      break;
-    } else if (a == "--drive" && value(&v)) {
-      o->drive = v;
-    } else if (a == "--frames" && value(&v)) {
-      o->frames = std::atoi(v.c_str());
-    } else if (a == "--timeout-s" && value(&v)) {
-      o->timeout_s = std::atof(v.c_str());
-    } else if (a == "--json" && value(&v)) {
-      o->json = v;
-    } else if (a == "--child-log" && value(&v)) {
-      o->child_log = v;
-    } else if (a == "--latency-csv" && value(&v)) {
-      o->latency_csv = v;
-    } else if (a == "--max-final-drift-m" && value(&v)) {
-      o->max_final_drift_m = std::atof(v.c_str());
-    } else if (a == "--max-rot-armse-rad" && value(&v)) {
-      o->max_rot_armse_rad = std::atof(v.c_str());
-    } else if (a == "--utc-offset-s" && value(&v)) {
-      o->utc_offset_s = std::atoll(v.c_str());
-    } else {
-      std::fprintf(stderr, "sunvo_pose_reader: bad argument '%s'\n", a.c_str());
-      return false;
-    }
-  }
-  return !o->drive.empty() && o->frames > 0 && !o->command.empty();
-}
-
 // The camera pose in the ENU world from an ODOMETRY message in MAV_FRAME_LOCAL_NED with the
 // camera-forward body: t_w = C_l_w^T p_l, C_w_c = C_l_w^T C_l_b C_b_c.
 sunvo::Isometry3 poseFromOdometry(const sunvo::mavlink::Odometry& m) {
@@ -135,19 +92,35 @@ double percentileMs(std::vector<double> v, double q) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  constexpr const char* kProgram = "sunvo_pose_reader";
   Options opt;
-  if (!parse(argc, argv, &opt)) {
-    usage();
-    return 2;
-  }
+  CLI::App app{
+      "The other end of sunvo_rover's serial port: starts COMMAND on a pseudo-terminal ({pty} in "
+      "it is replaced by the terminal's path), decodes its MAVLink poses, stops it after N poses "
+      "and evaluates accuracy and latency against the drive.",
+      kProgram};
+  app.add_option("--drive", opt.drive, "the drive the program replays (ground truth)")->required();
+  app.add_option("--frames", opt.frames, "poses to wait for")
+      ->required()
+      ->check(CLI::Range(1, 100000000));
+  app.add_option("--timeout-s", opt.timeout_s, "give up after this many seconds")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--json", opt.json, "write the evaluation as JSON");
+  app.add_option("--child-log", opt.child_log, "the program's stdout and stderr go here");
+  app.add_option("--latency-csv", opt.latency_csv, "the program's final_latency.csv");
+  app.add_option("--max-final-drift-m", opt.max_final_drift_m,
+                 "fail above this final drift, m (< 0: not checked)");
+  app.add_option("--max-rot-armse-rad", opt.max_rot_armse_rad,
+                 "fail above this rotation ARMSE, rad (< 0: not checked)");
+  app.add_option("--utc-offset-s", opt.utc_offset_s, "the drive's offset to UTC, s")
+      ->check(CLI::Range(-50400L, 50400L));
+  app.add_option("command", opt.command, "after --: the program and its arguments")->required();
+  if (auto code = sunvo::cli::parse(app, argc, argv)) return *code;
   sunvo::dataset::DatasetOptions dopt;
   dopt.path = opt.drive;
   dopt.utc_offset_s = opt.utc_offset_s;
   auto truth = sunvo::dataset::Dataset::open(dopt);
-  if (!truth) {
-    std::fprintf(stderr, "sunvo_pose_reader: %s\n", truth.status().message().c_str());
-    return 2;
-  }
+  if (!truth) return sunvo::cli::fail(kProgram, truth.status().message());
   // A looped replay (more frames than the drive) is evaluated on its first pass, whose frame
   // times are the drive's; later passes carry later times.
   const int truth_frames = std::min(opt.frames, static_cast<int>(truth->size()));

@@ -1,47 +1,34 @@
 // sunvo_render: renders a scenario into the KITTI raw layout.
 //   sunvo_render --scenario config/scenarios/ci_short.yaml --out <dir> [-j N] [--frames N]
+// Exit codes (firmware_app/cli): 0 ok, 2 a bad command line, 1 a scenario or render failure.
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
 #include <string>
 #include <thread>
 
+#include "sunvo/cli/cli.hpp"
 #include "sunvo/render/drive.hpp"
 
 int main(int argc, char** argv) {
+  constexpr const char* kProgram = "sunvo_render";
   std::string scenario, out;
-  int jobs = static_cast<int>(std::thread::hardware_concurrency());
+  int jobs = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
   int frames = -1;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
-    if (a == "--scenario")
-      scenario = next();
-    else if (a == "--out")
-      out = next();
-    else if (a == "-j")
-      jobs = std::atoi(next().c_str());
-    else if (a == "--frames")
-      frames = std::atoi(next().c_str());
-    else {
-      std::fprintf(stderr, "usage: %s --scenario FILE.yaml --out DIR [-j N] [--frames N]\n",
-                   argv[0]);
-      return 2;
-    }
-  }
-  if (scenario.empty() || out.empty()) {
-    std::fprintf(stderr, "usage: %s --scenario FILE.yaml --out DIR [-j N] [--frames N]\n", argv[0]);
-    return 2;
-  }
+  CLI::App app{"Renders a scenario (POV-Ray, physical sky, SPA sun) into the KITTI raw layout.",
+               kProgram};
+  app.add_option("--scenario", scenario, "the scenario YAML (config/scenarios/)")->required();
+  app.add_option("--out", out, "output folder")->required();
+  app.add_option("-j,--jobs", jobs, "parallel povray processes (default: the number of cores)")
+      ->check(CLI::Range(1, 1024));
+  app.add_option("--frames", frames, "render only the first N frames of the scenario")
+      ->check(CLI::Range(1, 10000000));
+  if (auto code = sunvo::cli::parse(app, argc, argv)) return *code;
   auto s = sunvo::render::loadScenario(scenario);
-  if (!s) {
-    std::fprintf(stderr, "sunvo_render: %s\n", s.status().toString().c_str());
-    return 1;
-  }
+  if (!s) return sunvo::cli::fail(kProgram, s.status());
   if (frames > 0) s->frames = frames;
-  if (jobs < 1) jobs = 1;
   const auto t0 = std::chrono::steady_clock::now();
   auto r = sunvo::render::renderDrive(*s, out, jobs, [&](const sunvo::render::DriveProgress& p) {
     const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -53,11 +40,11 @@ int main(int argc, char** argv) {
     if (p.done == p.total) std::fprintf(stderr, "\n");
   });
   if (!r) {
-    std::fprintf(stderr, "\nsunvo_render: %s\n", r.status().toString().c_str());
-    return 1;
+    std::fputc('\n', stderr);
+    return sunvo::cli::fail(kProgram, r.status());
   }
   const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::fprintf(stderr, "sunvo_render: %d frames in %.1f s (%.2f s/frame wall, -j %d) -> %s\n",
                s->frames, el, el / s->frames, jobs, r->c_str());
-  return 0;
+  return sunvo::cli::kExitOk;
 }

@@ -1,8 +1,9 @@
 // sunvo_sun: batch sun positions (NREL SPA) for a CSV of UTC times and places.
 //   sunvo_sun [-i IN.csv] [-o OUT.csv] [--delta-t S] [--delta-ut1 S] [--vector-zenith
 //             unrefracted|refracted] [--timing]
-// Reads stdin / writes stdout unless -i / -o are given. Exit status: 0 ok, 2 bad usage or bad
-// input (the message names file, line and field), 1 when the output cannot be written.
+// Reads stdin / writes stdout unless -i / -o are given. Exit status (firmware_app/cli): 0 ok,
+// 2 a bad command line or option value, 1 a bad input (the message names file, line and field) or
+// an output that cannot be written.
 
 #include <array>
 #include <cerrno>
@@ -11,89 +12,40 @@
 #include <fstream>
 #include <iostream>
 #include <string>
-#include <string_view>
 
+#include "sunvo/cli/cli.hpp"
 #include "sunvo/files/text_file.hpp"
 #include "sunvo/sun_cli/sun_csv.hpp"
 
-namespace {
-
-constexpr int kExitBadInput = 2;
-constexpr int kExitIoError = 1;
-
-void usage() {
-  std::cerr << "usage: sunvo_sun [-i IN.csv] [-o OUT.csv] [--delta-t S] [--delta-ut1 S]\n"
-               "                 [--vector-zenith unrefracted|refracted] [--timing]\n"
-               "  in:  utc_iso,lat_deg,lon_deg,alt_m,pressure_mbar,temp_c\n"
-               "  out: the same + zenith_deg,zenith_refracted_deg,azimuth_deg,east,north,up\n"
-               "  utc_iso: YYYY-MM-DD[T| ]HH:MM:SS[.fff] with Z, +hh:mm/-hh:mm or nothing (= UTC)\n"
-               "  --delta-t S     TT-UT1 in s (default: built-in table 1990-2025)\n"
-               "  --delta-ut1 S   UT1-UTC in s (default 0)\n"
-               "  --timing        print the time per SPA call to stderr\n";
-}
-
-bool parseNumber(const char* text, double& out) {
-  char* end = nullptr;
-  errno = 0;
-  out = std::strtod(text, &end);
-  return errno == 0 && end != text && *end == '\0';
-}
-
-}  // namespace
-
 int main(int argc, char** argv) {
+  constexpr const char* kProgram = "sunvo_sun";
   std::string in_path;
   std::string out_path;
   bool timing = false;
+  double delta_t_s = 0.0;
+  std::string vector_zenith = "unrefracted";
   sunvo::sun_cli::SunCsvOptions options;
-  for (int i = 1; i < argc; ++i) {
-    const std::string_view arg = argv[i];
-    auto value = [&]() -> const char* { return i + 1 < argc ? argv[++i] : nullptr; };
-    if (arg == "-h" || arg == "--help") {
-      usage();
-      return 0;
-    } else if (arg == "-i" || arg == "--input") {
-      const char* v = value();
-      if (!v) return usage(), kExitBadInput;
-      in_path = v;
-    } else if (arg == "-o" || arg == "--output") {
-      const char* v = value();
-      if (!v) return usage(), kExitBadInput;
-      out_path = v;
-    } else if (arg == "--delta-t" || arg == "--delta-ut1") {
-      const char* v = value();
-      double x = 0.0;
-      if (!v || !parseNumber(v, x)) {
-        std::cerr << "sunvo_sun: " << arg << " needs a number of seconds\n";
-        return kExitBadInput;
-      }
-      if (arg == "--delta-t") {
-        options.spa.delta_t_s = x;
-      } else {
-        options.spa.delta_ut1_s = x;
-      }
-    } else if (arg == "--vector-zenith") {
-      const char* v = value();
-      const std::string_view which = v ? v : "";
-      if (which == "unrefracted") {
-        options.spa.vector_zenith = sunvo::sun::SunVectorZenith::kUnrefracted;
-      } else if (which == "refracted") {
-        options.spa.vector_zenith = sunvo::sun::SunVectorZenith::kRefracted;
-      } else {
-        std::cerr << "sunvo_sun: --vector-zenith takes 'unrefracted' or 'refracted'\n";
-        return kExitBadInput;
-      }
-    } else if (arg == "--timing") {
-      timing = true;
-    } else {
-      std::cerr << "sunvo_sun: unknown argument '" << arg << "'\n";
-      usage();
-      return kExitBadInput;
-    }
-  }
+  CLI::App app{
+      "Batch sun positions (NREL SPA) for a CSV of UTC times and places.\n"
+      "  in:  utc_iso,lat_deg,lon_deg,alt_m,pressure_mbar,temp_c\n"
+      "  out: the same + zenith_deg,zenith_refracted_deg,azimuth_deg,east,north,up\n"
+      "  utc_iso: YYYY-MM-DD[T| ]HH:MM:SS[.fff] with Z, +hh:mm/-hh:mm or nothing (= UTC)",
+      kProgram};
+  app.add_option("-i,--input", in_path, "input CSV (default or -: standard input)");
+  app.add_option("-o,--output", out_path, "output CSV (default or -: standard output)");
+  app.add_option("--delta-t", delta_t_s, "TT-UT1, s (default: built-in table 1990-2025)");
+  app.add_option("--delta-ut1", options.spa.delta_ut1_s, "UT1-UTC, s");
+  app.add_option("--vector-zenith", vector_zenith, "zenith of the ENU sun vector")
+      ->check(CLI::IsMember({"unrefracted", "refracted"}));
+  app.add_flag("--timing", timing, "print the time per SPA call to stderr");
+  if (auto code = sunvo::cli::parse(app, argc, argv)) return *code;
+  if (app.count("--delta-t") > 0) options.spa.delta_t_s = delta_t_s;
+  options.spa.vector_zenith = vector_zenith == "refracted"
+                                  ? sunvo::sun::SunVectorZenith::kRefracted
+                                  : sunvo::sun::SunVectorZenith::kUnrefracted;
   if (const sunvo::Status s = options.validate(); !s.isOk()) {
-    std::cerr << "sunvo_sun: " << s.message() << "\n";
-    return kExitBadInput;
+    std::cerr << kProgram << ": " << s.message() << "\n";
+    return sunvo::cli::kExitUsage;
   }
 
   sunvo::Expected<sunvo::files::TextFile> input = [&]() -> sunvo::Expected<sunvo::files::TextFile> {
@@ -105,31 +57,21 @@ int main(int argc, char** argv) {
     if (std::ferror(stdin)) return sunvo::ioError("<stdin>: read failed");
     return sunvo::files::TextFile::fromString("<stdin>", std::move(content));
   }();
-  if (!input) {
-    std::cerr << "sunvo_sun: " << input.status().message() << "\n";
-    return kExitBadInput;
-  }
+  if (!input) return sunvo::cli::fail(kProgram, input.status().message());
 
   std::string out;
   auto stats = sunvo::sun_cli::convertSunCsv(*input, options, out);
-  if (!stats) {
-    std::cerr << "sunvo_sun: " << stats.status().message() << "\n";
-    return kExitBadInput;
-  }
+  if (!stats) return sunvo::cli::fail(kProgram, stats.status().message());
 
   if (out_path.empty() || out_path == "-") {
     std::cout << out << std::flush;
-    if (!std::cout) {
-      std::cerr << "sunvo_sun: writing stdout failed\n";
-      return kExitIoError;
-    }
+    if (!std::cout) return sunvo::cli::fail(kProgram, "writing stdout failed");
   } else {
     std::ofstream file(out_path, std::ios::binary);
     file << out;
     file.close();
     if (!file) {
-      std::cerr << "sunvo_sun: cannot write '" << out_path << "': " << std::strerror(errno) << "\n";
-      return kExitIoError;
+      return sunvo::cli::fail(kProgram, "cannot write '" + out_path + "': " + std::strerror(errno));
     }
   }
   if (timing) {
@@ -139,5 +81,5 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "sunvo_sun: %lld rows, %.3f us per SPA call\n",
                  static_cast<long long>(stats->rows), us);
   }
-  return 0;
+  return sunvo::cli::kExitOk;
 }

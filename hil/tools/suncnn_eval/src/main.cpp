@@ -7,7 +7,8 @@
 //       frame,sx,sy,sz
 //       [--every N]                        every Nth frame of each drive
 //       [--csv out.csv]                    one line per image
-// Grey images are fed as BGR (Y, Y, Y). Exit status 1 on any error.
+// Grey images are fed as BGR (Y, Y, Y). Exit status (firmware_app/cli): 0 ok, 2 a bad command
+// line or option value, 1 any other error.
 #include <time.h>
 
 #include <chrono>
@@ -25,6 +26,7 @@
 #include <string>
 #include <vector>
 
+#include "sunvo/cli/cli.hpp"
 #include "sunvo/metrics/metrics.hpp"
 #include "sunvo/suncnn/sun_cnn_estimator.hpp"
 
@@ -81,60 +83,53 @@ struct SetResult {
   int valid = 0;
 };
 
-int usage(const char* argv0) {
-  std::fprintf(stderr,
-               "usage: %s --model FILE.onnx [--threads N] [--mc N] [--sigma-scale S] [--every N]\n"
-               "          [--drive DIR]... [--odometry DIR --sun-csv FILE] [--csv OUT]\n",
-               argv0);
-  return 2;
-}
 }  // namespace
 
 int main(int argc, char** argv) {
+  constexpr const char* kProgram = "sunvo_sun_cnn_eval";
   std::string model, odometry, sun_csv, csv_out;
   std::vector<std::string> drives;
   int threads = 1, every = 1;
   sunvo::suncnn::SunCnnOptions options;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
-    if (a == "--model")
-      model = next();
-    else if (a == "--threads")
-      threads = std::atoi(next().c_str());
-    else if (a == "--mc")
-      options.mc_samples = std::atoi(next().c_str());
-    else if (a == "--sigma-scale")
-      options.sigma_scale = std::atof(next().c_str());
-    else if (a == "--every")
-      every = std::max(1, std::atoi(next().c_str()));
-    else if (a == "--drive")
-      drives.push_back(next());
-    else if (a == "--odometry")
-      odometry = next();
-    else if (a == "--sun-csv")
-      sun_csv = next();
-    else if (a == "--csv")
-      csv_out = next();
-    else
-      return usage(argv[0]);
+  CLI::App app{
+      "Sun-CNN azimuth error, reported sigma and time per call on image sets with a known "
+      "sun (rendered drives, KITTI odometry frames).",
+      kProgram};
+  app.add_option("--model", model, "the Sun-CNN ONNX model")->required();
+  app.add_option("--threads", threads, "OpenCV threads")->check(CLI::Range(1, 1024));
+  app.add_option("--mc", options.mc_samples, "MC-dropout samples per image (0: none)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--sigma-scale", options.sigma_scale, "calibration factor on the spread sigma")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--every", every, "every N-th frame of each set")->check(CLI::Range(1, 1000000));
+  auto* drive = app.add_option("--drive", drives,
+                               "a rendered or KITTI raw drive: image_02/data + gt/sun_cam0.csv "
+                               "(repeatable)");
+  auto* odo = app.add_option("--odometry", odometry, "KITTI odometry frames: grey image_0/*.png");
+  app.add_option("--sun-csv", sun_csv, "frame,sx,sy,sz of the --odometry frames")->needs(odo);
+  odo->needs("--sun-csv");
+  app.add_option("--csv", csv_out, "one line per image");
+  if (auto code = sunvo::cli::parse(app, argc, argv)) return *code;
+  if (drive->count() == 0 && odo->count() == 0) {
+    std::fprintf(stderr,
+                 "%s: give at least one --drive or --odometry\nRun with --help for more "
+                 "information.\n",
+                 kProgram);
+    return sunvo::cli::kExitUsage;
   }
-  if (model.empty() || (drives.empty() && odometry.empty())) return usage(argv[0]);
+  if (const Status st = options.validate(); !st.isOk()) {
+    std::fprintf(stderr, "%s: %s\n", kProgram, st.toString().c_str());
+    return sunvo::cli::kExitUsage;
+  }
   cv::setNumThreads(threads);
   sunvo::suncnn::SunCnnEstimator est;
-  if (Status st = est.init(options, model); !st.isOk()) {
-    std::fprintf(stderr, "sun_cnn_eval: %s\n", st.toString().c_str());
-    return 1;
-  }
+  if (Status st = est.init(options, model); !st.isOk()) return sunvo::cli::fail(kProgram, st);
 
   // The sets: one per drive, one for the odometry frames.
   std::vector<std::pair<std::string, std::vector<Item>>> sets;
   for (const std::string& d : drives) {
     auto sun = readSunCsv(d + "/gt/sun_cam0.csv");
-    if (!sun) {
-      std::fprintf(stderr, "sun_cnn_eval: %s\n", sun.status().toString().c_str());
-      return 1;
-    }
+    if (!sun) return sunvo::cli::fail(kProgram, sun.status());
     std::vector<Item> items;
     for (const auto& [k, s] : *sun) {
       if (k % every != 0) continue;
@@ -148,12 +143,12 @@ int main(int argc, char** argv) {
   }
   if (!odometry.empty()) {
     auto sun = readSunCsv(sun_csv);
-    if (!sun) {
-      std::fprintf(stderr, "sun_cnn_eval: %s\n", sun.status().toString().c_str());
-      return 1;
-    }
+    if (!sun) return sunvo::cli::fail(kProgram, sun.status());
     std::vector<Item> items;
-    for (const auto& e : fs::directory_iterator(odometry + "/image_0")) {
+    std::error_code ec;
+    const fs::directory_iterator frames(odometry + "/image_0", ec);
+    if (ec) return sunvo::cli::fail(kProgram, odometry + "/image_0: " + ec.message());
+    for (const auto& e : frames) {
       const int k = std::atoi(e.path().stem().string().c_str());
       if (auto it = sun->find(k); it != sun->end())
         items.push_back({e.path().string(), it->second});
@@ -164,6 +159,9 @@ int main(int argc, char** argv) {
   }
 
   std::FILE* csv = csv_out.empty() ? nullptr : std::fopen(csv_out.c_str(), "w");
+  if (!csv_out.empty() && csv == nullptr) {
+    return sunvo::cli::fail(kProgram, csv_out + ": cannot open for writing");
+  }
   if (csv) std::fprintf(csv, "set,image,true_az_deg,est_az_deg,err_deg,sigma_deg,valid,time_ms\n");
   SetResult all;
   // Times per call, ms: wall (t_) and this thread's CPU (cpu_), median and p90.
@@ -187,21 +185,14 @@ int main(int argc, char** argv) {
     SetResult r;
     for (const Item& it : items) {
       cv::Mat img = cv::imread(it.image, cv::IMREAD_UNCHANGED);
-      if (img.empty()) {
-        std::fprintf(stderr, "sun_cnn_eval: cannot read %s\n", it.image.c_str());
-        return 1;
-      }
+      if (img.empty()) return sunvo::cli::fail(kProgram, "cannot read " + it.image);
       if (img.channels() == 1) cv::cvtColor(img, img, cv::COLOR_GRAY2BGR);
       sunvo::sunfusion::ImageSunInput in;
       in.color = img;
       const double cpu0 = threadCpuMs();
       auto e = est.estimate(in);
       r.cpu_ms.push_back(threadCpuMs() - cpu0);
-      if (!e) {
-        std::fprintf(stderr, "sun_cnn_eval: %s: %s\n", it.image.c_str(),
-                     e.status().toString().c_str());
-        return 1;
-      }
+      if (!e) return sunvo::cli::fail(kProgram, it.image + ": " + e.status().toString());
       const double truth = azimuthDeg(it.sun_c);
       double err = std::fabs(std::remainder(e->azimuth_deg - truth, 360.0));
       const double sigma_deg = e->measurement.sigma * 180.0 / std::numbers::pi;
@@ -225,5 +216,5 @@ int main(int argc, char** argv) {
   }
   if (sets.size() > 1) print("ALL", all);
   if (csv) std::fclose(csv);
-  return 0;
+  return sunvo::cli::kExitOk;
 }

@@ -226,6 +226,9 @@ struct TelemetryConfig {
   double position_sigma_m = 0.1;    // m, (0, 1000]: reported position std when tracking
   double attitude_sigma_deg = 1.0;  // deg, (0, 180]: reported attitude std when tracking
   int full_quality_inliers = 150;   // RANSAC inliers that count as quality 100, [1, 100000]
+  // TUM pose log of every published pose (pose_log.hpp), appended to; empty: none.
+  std::string pose_log;
+  int pose_log_buffer_kb = 64;  // KiB, [1, 65536]: the log's line buffer, written when full
   template <class Self, class V>
   static void fields(Self& s, V& v) {
     v("heartbeat_hz", s.heartbeat_hz);
@@ -234,6 +237,8 @@ struct TelemetryConfig {
     v("position_sigma_m", s.position_sigma_m);
     v("attitude_sigma_deg", s.attitude_sigma_deg);
     v("full_quality_inliers", s.full_quality_inliers);
+    v("pose_log", s.pose_log);
+    v("pose_log_buffer_kb", s.pose_log_buffer_kb);
   }
 };
 

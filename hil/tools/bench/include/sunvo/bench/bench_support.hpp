@@ -13,19 +13,23 @@
 #include "sunvo/core/time.hpp"
 #include "sunvo/kitti/stereo_source.hpp"
 
+namespace CLI {
+class App;
+}
+
 namespace sunvo::bench {
 
 using KittiFrames = kitti::LoadedFrames;
 
-// Flags every benchmark takes: --frames=N --warmup=N --cpu=K --data=DIR.
+// Options every benchmark takes: --frames=N --warmup=N --cpu=K --data=DIR.
 struct BenchConfig {
   int frames = 500;  // timed frames, >= 1
   int warmup = 20;   // frames before timing, >= 0
   std::string data = std::string(SUNVO_DATA_DIR) + "/kitti_odometry/00_first_frames";
   int cpu = -1;  // pin to this CPU when >= 0
 };
-// Consumes one of the common flags into `config`; false when `arg` is not one of them.
-bool parseBenchFlag(const std::string& arg, BenchConfig& config);
+// Adds those options to a program's command line (typed and range-checked, firmware_app/cli).
+void addBenchOptions(CLI::App& app, BenchConfig& config);
 // Pins to config.cpu (when >= 0), fails when the allocation counter is not linked in (the
 // caller passes runtime::allocCounterActive(), which only benchmark executables link), and loads
 // the frames of config.data.

@@ -1,0 +1,34 @@
+#pragma once
+// The command line of the Google Benchmark executables: sunvo's convention (firmware_app/cli) for
+// their own options; what CLI11 does not know goes on to Google Benchmark (--benchmark_filter=,
+// --benchmark_format=, ...), and what neither knows is a usage error (exit 2). Header-only: only
+// the executables that link Google Benchmark include it.
+
+#include <benchmark/benchmark.h>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "sunvo/cli/cli.hpp"
+
+namespace sunvo::bench {
+
+// sunvo::cli::parse with the leftovers handed to benchmark::Initialize. nullopt: go on; else the
+// exit code (help, version, usage error).
+inline std::optional<int> parseWithBenchmarkFlags(CLI::App& app, int argc, char** argv) {
+  app.allow_extras();
+  app.footer("Options --benchmark_*=VALUE go to Google Benchmark (e.g. --benchmark_format=json).");
+  if (auto code = cli::parse(app, argc, argv)) return code;
+  std::vector<std::string> rest = app.remaining();
+  std::vector<char*> bench_argv{argv[0]};
+  for (std::string& arg : rest) bench_argv.push_back(arg.data());
+  int bench_argc = static_cast<int>(bench_argv.size());
+  benchmark::Initialize(&bench_argc, bench_argv.data());
+  if (benchmark::ReportUnrecognizedArguments(bench_argc, bench_argv.data())) {
+    return cli::kExitUsage;
+  }
+  return std::nullopt;
+}
+
+}  // namespace sunvo::bench
