@@ -118,6 +118,9 @@ Status SunWindowTerm::init(const SunFusionOptions& options) {
   }
   last_sequence_.reset();
   num_used_ = 0;
+  last_correction_ = Correction{};
+  num_corrections_ = 0;
+  last_nis_ = 0.0;
   return Status::ok();
 }
 
@@ -161,6 +164,7 @@ Status SunWindowTerm::onSolve(backend::BundleWindow& window) {
         cost_built = true;
         Innovation inn;
         const bool finite = innovation(*p.cost, window.T_k_b(s), P_b, &inn);
+        if (finite) last_nis_ = inn.nis;
         if (!finite ||
             (options_.innovation_gate_chi2 > 0.0 && inn.nis > options_.innovation_gate_chi2)) {
           r = GateResult::kRejectedInnovation;
@@ -216,6 +220,7 @@ void SunWindowTerm::onSolved(backend::BundleWindow& window) {
     info_b += J.transpose() * J;
   }
   const Eigen::Vector3d delta_b(delta_[0], delta_[1], delta_[2]);
+  const int used = num_used_;
   delta_ = {0.0, 0.0, 0.0};
   num_used_ = 0;
   if (!delta_b.allFinite() || !info_b.allFinite()) return;
@@ -230,6 +235,8 @@ void SunWindowTerm::onSolved(backend::BundleWindow& window) {
   if (!P_new.allFinite()) return;
   P_ = P_new;
   window.correctBaseAttitude(expSO3(delta_b));
+  last_correction_ = {window.sequence(window.size() - 1), C_w_b * delta_b, used};
+  ++num_corrections_;
 }
 
 void SunWindowTerm::propagate(double frames) {

@@ -146,6 +146,18 @@ class SunWindowTerm {
   double driftDegPerFrame() const { return drift_deg_per_frame_; }
   // Last value of the persistence statistic T (0 before the first accepted measurement).
   double persistenceStatistic() const { return persistence_T_; }
+  // The last correction of the base's world attitude (base-attitude mode), for diagnostics:
+  // dtheta_w = C_w_b delta_b (rad, world frame; the VO world attitude turns by Exp(dtheta_w)),
+  // the newest frame of the solve that made it, and how many measurements it used.
+  struct Correction {
+    std::uint64_t sequence = 0;
+    Eigen::Vector3d dtheta_w = Eigen::Vector3d::Zero();
+    int measurements = 0;
+  };
+  const Correction& lastCorrection() const { return last_correction_; }
+  std::uint64_t numCorrections() const { return num_corrections_; }
+  // r^T S^-1 r of the last measurement that reached the innovation gate (0 before the first).
+  double lastInnovationNis() const { return last_nis_; }
 
  private:
   struct Pending {
@@ -196,6 +208,9 @@ class SunWindowTerm {
   std::unique_ptr<ceres::CostFunction> prior_cost_;
   std::array<int, backend::BundleWindow::kMaxWindowSize> used_in_solve_{};  // ring indices
   int num_used_ = 0;
+  Correction last_correction_;
+  std::uint64_t num_corrections_ = 0;
+  double last_nis_ = 0.0;
 };
 
 }  // namespace sunvo::sunfusion
