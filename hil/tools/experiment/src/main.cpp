@@ -55,6 +55,7 @@ int main(int argc, char** argv) {
   std::string routes_arg = "0020,00,06";
   int frames = 0, every = 5, seed = 1;
   std::optional<double> drift_deg, sun_loss, initial_sigma_deg, max_drift_deg, innovation_gate;
+  std::optional<double> evidence_sigmas, max_correction_deg;
   bool paper_form = false;
   bool write_poses = false;
   bool fixed_drift = false;
@@ -81,7 +82,13 @@ int main(int argc, char** argv) {
   app.add_flag("--paper-form", paper_form, "hold the base attitude fixed, as the paper did");
   app.add_flag("--fixed-drift", fixed_drift, "keep the random walk at --drift-deg");
   app.add_option("--drift-rule", drift_rule, "how the random walk adapts")
-      ->check(CLI::IsMember({"persistence", "median", "fixed"}));
+      ->check(CLI::IsMember({"persistence", "median", "fixed", "evidence"}));
+  app.add_option("--evidence-sigmas", evidence_sigmas,
+                 "evidence rule: sigmas an error must reach before P covers it")
+      ->check(CLI::Range(0.0, 100.0));
+  app.add_option("--max-correction-deg", max_correction_deg,
+                 "refuse a measurement that would turn the attitude more, deg (0 = off)")
+      ->check(CLI::Range(0.0, 180.0));
   app.add_option("--innovation-gate", innovation_gate,
                  "chi-square bound of the innovation gate (0 = off)")
       ->check(CLI::Range(0.0, 1e6));
@@ -119,7 +126,11 @@ int main(int argc, char** argv) {
     options.fusion.drift_adaptation = sunvo::sunfusion::DriftAdaptation::kInnovationMedian;
   } else if (drift_rule == "fixed") {
     options.fusion.drift_adaptation = sunvo::sunfusion::DriftAdaptation::kFixed;
+  } else if (drift_rule == "evidence") {
+    options.fusion.drift_adaptation = sunvo::sunfusion::DriftAdaptation::kEvidence;
   }
+  if (evidence_sigmas) options.fusion.evidence_sigmas = *evidence_sigmas;
+  if (max_correction_deg) options.fusion.max_correction_deg = *max_correction_deg;
   if (innovation_gate) options.fusion.innovation_gate_chi2 = *innovation_gate;
   if (auto s = options.validate(); !s.isOk()) {
     std::fprintf(stderr, "%s: %s\n", kProgram, s.toString().c_str());

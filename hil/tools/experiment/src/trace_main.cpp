@@ -40,7 +40,7 @@ std::vector<std::string> splitComma(const std::string& s) {
 }
 
 struct FrameTrace {
-  Eigen::Vector3d e_w = Eigen::Vector3d::Zero();  // attitude error, world axes, rad
+  Eigen::Vector3d e_w = Eigen::Vector3d::Zero();      // attitude error, world axes, rad
   Eigen::Vector3d e_c = Eigen::Vector3d::Zero();      // attitude error, camera axes, rad
   Eigen::Vector3d sigma_c = Eigen::Vector3d::Zero();  // sqrt(diag(P)) in camera axes, rad
   double nees = 0.0;
@@ -154,15 +154,17 @@ std::string summarize(const std::string& id, const std::string& name, const Trac
     helped += f.gain_deg > 0.0 ? 1 : 0;
   }
   const Eigen::Vector3d s_end = fr.back().sigma_c / kDeg;
-  std::snprintf(buf, sizeof(buf),
-                "| %s | %s | %llu / %llu / %llu / %llu | %s | %.0f, %.0f, %.0f | %.2f, %.2f, %.2f "
-                "| %.2f, %.2f, %.2f | %zu | %.3f | %.2f | %+.2f | %d |\n",
-                id.c_str(), name.c_str(), static_cast<unsigned long long>(g.accepted),
-                static_cast<unsigned long long>(g.rejected_cosine),
-                static_cast<unsigned long long>(g.rejected_vertical),
-                static_cast<unsigned long long>(g.rejected_innovation), quarters.c_str(), z2.x(),
-                z2.y(), z2.z(), s_end.x(), s_end.y(), s_end.z(), e_end.x(), e_end.y(), e_end.z(),
-                corr.size(), median(corr), sum_corr, sum_gain, helped);
+  std::snprintf(
+      buf, sizeof(buf),
+      "| %s | %s | %llu / %llu / %llu / %llu / %llu | %s | %.0f, %.0f, %.0f | %.2f, %.2f, %.2f "
+      "| %.2f, %.2f, %.2f | %zu | %.3f | %.2f | %+.2f | %d |\n",
+      id.c_str(), name.c_str(), static_cast<unsigned long long>(g.accepted),
+      static_cast<unsigned long long>(g.rejected_cosine),
+      static_cast<unsigned long long>(g.rejected_vertical),
+      static_cast<unsigned long long>(g.rejected_innovation),
+      static_cast<unsigned long long>(g.rejected_correction), quarters.c_str(), z2.x(), z2.y(),
+      z2.z(), s_end.x(), s_end.y(), s_end.z(), e_end.x(), e_end.y(), e_end.z(), corr.size(),
+      median(corr), sum_corr, sum_gain, helped);
   return buf;
 }
 
@@ -174,8 +176,9 @@ int main(int argc, char** argv) {
   std::string routes_arg = "0020,00";
   std::string sources_arg = "1,2,3,4";
   int frames = 0, seed = 1;
-  std::optional<double> drift_deg, initial_sigma_deg, max_drift_deg;
-  bool fixed_drift = false;
+  std::optional<double> drift_deg, initial_sigma_deg, max_drift_deg, evidence_sigmas,
+      max_correction_deg, forgetting;
+  bool fixed_drift = false, evidence = false;
   CLI::App app{"Traces the sun fusion's gate, covariance and corrections against ground truth.",
                kProgram};
   app.add_option("--data", data_dir, "folder of the real data (shared/data layout)");
@@ -195,6 +198,13 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.0, 45.0));
   app.add_option("--max-drift-deg", max_drift_deg, "cap of the adapted random walk, deg/frame")
       ->check(CLI::Range(0.0, 5.0));
+  app.add_flag("--evidence", evidence, "the evidence rule (covariance matching)");
+  app.add_option("--evidence-sigmas", evidence_sigmas, "evidence rule: threshold in sigmas")
+      ->check(CLI::Range(0.0, 100.0));
+  app.add_option("--forgetting", forgetting, "forgetting factor of the evidence sums")
+      ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--max-correction-deg", max_correction_deg, "correction gate, deg (0 = off)")
+      ->check(CLI::Range(0.0, 180.0));
   if (auto code = sunvo::cli::parse(app, argc, argv)) return *code;
 
   std::error_code ec;
@@ -207,12 +217,20 @@ int main(int argc, char** argv) {
   if (fixed_drift) options.fusion.drift_adaptation = sunvo::sunfusion::DriftAdaptation::kFixed;
   if (initial_sigma_deg) options.fusion.initial_attitude_sigma_deg = *initial_sigma_deg;
   if (max_drift_deg) options.fusion.max_drift_deg_per_frame = *max_drift_deg;
+  if (evidence) options.fusion.drift_adaptation = sunvo::sunfusion::DriftAdaptation::kEvidence;
+  if (evidence_sigmas) options.fusion.evidence_sigmas = *evidence_sigmas;
+  if (forgetting) options.fusion.persistence_forgetting = *forgetting;
+  if (max_correction_deg) options.fusion.max_correction_deg = *max_correction_deg;
   if (auto s = options.validate(); !s.isOk()) return sunvo::cli::fail(kProgram, s);
   const auto sources = sunvo::experiment::defaultSunSources(static_cast<std::uint32_t>(seed));
 
+  std::string metrics =
+      "| route | run | final drift [m] (change) | rot. ARMSE [1e-3] (change) "
+      "|\n|---|---|---|---|\n";
   std::string pure = "| route | run | pure VO attitude error |\n|---|---|---|\n";
   std::string table =
-      "| route | source | accepted / cosine / vertical / innovation | NEES by quarter | mean "
+      "| route | source | accepted / cosine / vertical / innovation / correction | NEES by quarter "
+      "| mean "
       "z^2 (x, y, z) | final sigma [deg] (x, y, z) | final error [deg] (x, y, z) | corrections "
       "| median corr [deg] | sum corr [deg] | sum gain [deg] | corrections that helped |\n"
       "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
@@ -222,6 +240,7 @@ int main(int argc, char** argv) {
     auto route = sunvo::experiment::loadRoute(spec, data_dir, sim);
     if (!route)
       return sunvo::cli::fail(kProgram, "route " + spec + ": " + route.status().toString());
+    sunvo::metrics::Table1Metrics base;
     std::vector<int> runs = {0};
     for (const std::string& s : splitComma(sources_arg)) runs.push_back(std::stoi(s));
     for (int i : runs) {
@@ -256,11 +275,19 @@ int main(int argc, char** argv) {
       if (auto s = sunvo::files::writeWholeFile(path, csv); !s.isOk()) {
         return sunvo::cli::fail(kProgram, s);
       }
+      const auto& t1 = run->evaluation.table1;
+      if (i == 0) base = t1;
+      char m[256];
+      std::snprintf(m, sizeof(m), "| %s | %s | %.2f (%+.0f %%) | %.2f (%+.0f %%) |\n", id.c_str(),
+                    run->name.c_str(), t1.final_drift_m,
+                    100.0 * (t1.final_drift_m / base.final_drift_m - 1.0), t1.rot_armse_rad * 1e3,
+                    100.0 * (t1.rot_armse_rad / base.rot_armse_rad - 1.0));
+      metrics += m;
       const std::string row = summarize(id, run->name, tracer, run->gate, i > 0);
       (i > 0 ? table : pure) += row;
       std::fprintf(stderr, "%s", row.c_str());
     }
   }
-  std::printf("%s\n%s", pure.c_str(), table.c_str());
+  std::printf("%s\n%s\n%s", metrics.c_str(), pure.c_str(), table.c_str());
   return 0;
 }
