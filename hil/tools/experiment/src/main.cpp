@@ -60,6 +60,7 @@ int main(int argc, char** argv) {
   bool write_poses = false;
   bool fixed_drift = false;
   std::string drift_rule = "persistence";
+  std::string forms_arg = "sunvo";
   CLI::App app{
       "The paper's experiment: pure VO against VO + sun from several sun sources, per route.",
       kProgram};
@@ -79,7 +80,11 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.0, 5.0));
   app.add_option("--sun-loss", sun_loss, "Cauchy scale on the whitened sun residual (0 = none)")
       ->check(CLI::Range(0.0, 100.0));
-  app.add_flag("--paper-form", paper_form, "hold the base attitude fixed, as the paper did");
+  app.add_flag("--paper-form", paper_form,
+               "hold the base attitude fixed, as the paper did (same as --forms paper)");
+  app.add_option("--forms", forms_arg,
+                 "comma-separated fusion forms, each a column per source: sunvo (the base "
+                 "attitude is estimated), paper (held fixed, as the paper did)");
   app.add_flag("--fixed-drift", fixed_drift, "keep the random walk at --drift-deg");
   app.add_option("--drift-rule", drift_rule, "how the random walk adapts")
       ->check(CLI::IsMember({"persistence", "median", "fixed", "evidence"}));
@@ -99,9 +104,10 @@ int main(int argc, char** argv) {
   app.add_option("--max-drift-deg", max_drift_deg,
                  "upper bound of the adapted random walk, deg/frame")
       ->check(CLI::Range(0.0, 5.0));
-  app.add_flag("--write-poses", write_poses,
-               "also write every run's poses and the ground truth as KITTI and TUM files "
-               "(route_<id>_gt, route_<id>_run<i>; run 0 is pure VO, then the sources)");
+  app.add_flag(
+      "--write-poses", write_poses,
+      "also write every run's poses and the ground truth as KITTI and TUM files "
+      "(route_<id>_gt, route_<id>_run<i>; run 0 is pure VO, then the sources, each in every form)");
   if (auto code = sunvo::cli::parse(app, argc, argv)) return *code;
 
   std::error_code ec;
@@ -118,7 +124,18 @@ int main(int argc, char** argv) {
   options.vo.window.max_solver_time_in_seconds = 60.0;
   if (drift_deg) options.fusion.attitude_drift_deg_per_frame = *drift_deg;
   if (sun_loss) options.fusion.loss_scale = *sun_loss;
-  options.fusion.estimate_base_attitude = !paper_form;
+  if (paper_form) forms_arg = "paper";
+  const std::vector<std::string> forms = splitComma(forms_arg);
+  for (const std::string& f : forms) {
+    if (f != "sunvo" && f != "paper") {
+      std::fprintf(stderr, "%s: --forms: unknown form '%s' (sunvo, paper)\n", kProgram, f.c_str());
+      return sunvo::cli::kExitUsage;
+    }
+  }
+  if (forms.empty()) {
+    std::fprintf(stderr, "%s: --forms: no form given\n", kProgram);
+    return sunvo::cli::kExitUsage;
+  }
   if (fixed_drift) options.fusion.drift_adaptation = sunvo::sunfusion::DriftAdaptation::kFixed;
   if (initial_sigma_deg) options.fusion.initial_attitude_sigma_deg = *initial_sigma_deg;
   if (max_drift_deg) options.fusion.max_drift_deg_per_frame = *max_drift_deg;
@@ -150,10 +167,20 @@ int main(int argc, char** argv) {
       return sunvo::cli::fail(kProgram, "route " + route_spec + ": " + route.status().toString());
     std::fprintf(stderr, "route %s: %zu frames\n", route->name.c_str(), route->frames.size());
     std::vector<RunResult> runs;
-    for (std::size_t s = 0; s <= sources.size(); ++s) {
-      std::optional<sunvo::experiment::SunSourceSpec> spec;
-      if (s > 0) spec = sources[s - 1];
-      auto run = sunvo::experiment::runRoute(*route, spec, options);
+    // Pure VO, then every source in every form (the paper's columns marked when both are shown).
+    std::vector<std::pair<std::optional<sunvo::experiment::SunSourceSpec>, bool>> plan = {
+        {std::nullopt, false}};
+    for (const auto& src : sources) {
+      for (const std::string& f : forms) {
+        sunvo::experiment::SunSourceSpec spec = src;
+        if (f == "paper" && forms.size() > 1) spec.name += " paper form";
+        plan.push_back({spec, f == "paper"});
+      }
+    }
+    for (const auto& [spec, paper] : plan) {
+      sunvo::experiment::ExperimentOptions run_options = options;
+      run_options.fusion.estimate_base_attitude = !paper;
+      auto run = sunvo::experiment::runRoute(*route, spec, run_options);
       if (!run) return sunvo::cli::fail(kProgram, route->name + ": " + run.status().toString());
       std::fprintf(stderr, "  %-28s done (%.2f ms/frame median, %d lost)\n", run->name.c_str(),
                    run->median_ms, run->lost_frames);
