@@ -136,16 +136,18 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "%s: --forms: no form given\n", kProgram);
     return sunvo::cli::kExitUsage;
   }
-  if (fixed_drift) options.fusion.drift_adaptation = sunvo::sunfusion::DriftAdaptation::kFixed;
   if (initial_sigma_deg) options.fusion.initial_attitude_sigma_deg = *initial_sigma_deg;
   if (max_drift_deg) options.fusion.max_drift_deg_per_frame = *max_drift_deg;
-  if (drift_rule == "median") {
+  if (drift_rule == "persistence") {
+    options.fusion.drift_adaptation = sunvo::sunfusion::DriftAdaptation::kPersistence;
+  } else if (drift_rule == "median") {
     options.fusion.drift_adaptation = sunvo::sunfusion::DriftAdaptation::kInnovationMedian;
   } else if (drift_rule == "fixed") {
     options.fusion.drift_adaptation = sunvo::sunfusion::DriftAdaptation::kFixed;
   } else if (drift_rule == "evidence") {
     options.fusion.drift_adaptation = sunvo::sunfusion::DriftAdaptation::kEvidence;
   }
+  if (fixed_drift) options.fusion.drift_adaptation = sunvo::sunfusion::DriftAdaptation::kFixed;
   if (evidence_sigmas) options.fusion.evidence_sigmas = *evidence_sigmas;
   if (max_correction_deg) options.fusion.max_correction_deg = *max_correction_deg;
   if (innovation_gate) options.fusion.innovation_gate_chi2 = *innovation_gate;
