@@ -322,6 +322,22 @@ TEST_F(SunWindowTermTest, EvidenceRuleWidensPOnlyWhereTheErrorStandsOutOfTheNois
   EXPECT_TRUE(precise.attitudeCovariance().allFinite());
 }
 
+TEST_F(SunWindowTermTest, EvidenceRuleDiscountsASourceWithCorrelatedErrors) {
+  // The precise measurements of the standing 2 deg error above, now from a source whose errors
+  // are stated to stay alike for 100 measurements: 21 of them count as less than one independent
+  // one, and P is not widened. A standing source bias looks exactly like this.
+  SunFusionOptions opt = baseAttitudeOptions();
+  opt.initial_attitude_sigma_deg = 0.1;
+  opt.innovation_gate_chi2 = 0.0;
+  opt.drift_adaptation = DriftAdaptation::kEvidence;
+  opt.evidence_correlation = 100.0;
+  SunWindowTerm correlated, unused;
+  solvePreciseAndImprecise(opt, &correlated, &unused);
+  EXPECT_EQ(correlated.numInflations(), 0u);
+  EXPECT_LT(std::sqrt(correlated.attitudeCovariance().eigenvalues().real().maxCoeff()) / kDeg,
+            0.15);
+}
+
 TEST_F(SunWindowTermTest, EvidenceRuleIgnoresZeroMeanNoiseAndOutliers) {
   // As for the persistence rule: no attitude error, 11 deg noise and 20 % of 40 deg outliers.
   T_w_b_est_ = Isometry3::Identity();
@@ -410,6 +426,9 @@ TEST(SunFusionOptionsTest, ValidationNamesTheBadKey) {
   opt = SunFusionOptions{};
   opt.evidence_forgetting = 1.0;
   EXPECT_NE(opt.validate().toString().find("evidence_forgetting"), std::string::npos);
+  opt = SunFusionOptions{};
+  opt.evidence_correlation = 0.5;
+  EXPECT_NE(opt.validate().toString().find("evidence_correlation"), std::string::npos);
   opt = SunFusionOptions{};
   opt.max_correction_deg = -1.0;
   EXPECT_NE(opt.validate().toString().find("max_correction_deg"), std::string::npos);

@@ -99,6 +99,9 @@ Status SunFusionOptions::validate() const {
   if (!(evidence_forgetting > 0.0 && evidence_forgetting < 1.0)) {
     return invalidArgument("fusion.evidence_forgetting out of range (0, 1)");
   }
+  if (!(evidence_correlation >= 1.0 && evidence_correlation <= 1000.0)) {
+    return invalidArgument("fusion.evidence_correlation out of range [1, 1000]");
+  }
   if (!(max_correction_deg >= 0.0 && max_correction_deg <= 180.0)) {
     return invalidArgument("fusion.max_correction_deg out of range [0, 180]");
   }
@@ -361,7 +364,8 @@ void SunWindowTerm::inflateToEvidence() {
     const double e = v.dot(persistence_g_) / l;
     T += e * e * l;
     const double deficit = e * e - v.dot(P_ * v);
-    if (e * e * l > options_.evidence_sigmas * options_.evidence_sigmas && deficit > 0.0 &&
+    const double bound = options_.evidence_sigmas * options_.evidence_sigmas;
+    if (e * e * l > bound * options_.evidence_correlation && deficit > 0.0 &&
         std::isfinite(deficit)) {
       P_ += deficit * v * v.transpose();
       ++num_inflations_;

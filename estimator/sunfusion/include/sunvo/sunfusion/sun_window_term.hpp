@@ -45,7 +45,8 @@
 //      with the estimate (after a correction c_w, g <- g - I c_w, so they describe the error that
 //      is left); they forget by evidence_forgetting. Along each eigen-direction v of I with
 //      eigenvalue l of at least a tenth of the largest, e = v^T g / l estimates the
-//      remaining world attitude error with variance 1/l; when |e| > evidence_sigmas / sqrt(l),
+//      remaining world attitude error with variance tau/l (tau = evidence_correlation, the
+//      source's error correlation length in measurements); when |e| > evidence_sigmas sqrt(tau/l),
 //      P grows by (e^2 - v^T P v) v v^T where that is positive. With R_s >> P a single
 //      innovation cannot tell P is too small (docs/experiment.md, measured), about 50 of them can.
 //  - Correction gate: with max_correction_deg > 0 a measurement whose predicted correction
@@ -123,6 +124,11 @@ struct SunFusionOptions {
   // measurement, (0, 1) (0.99: about the last 100). Uses persistence_huber.
   double evidence_sigmas = 3.0;
   double evidence_forgetting = 0.99;
+  // Evidence rule: the source's error correlation length in measurements, [1, 1000]. The test
+  // assumes independent errors; an estimator whose errors stay alike for tau measurements (a
+  // street-long bias) gives about 1/tau as many independent ones, so the estimate's variance is
+  // taken tau times larger (decorrelation in time). 1 = independent (the error models).
+  double evidence_correlation = 1.0;
   // deg, [0, 180]; 0 = off: refuse a measurement whose predicted correction of the attitude is
   // larger (counted as rejected_correction).
   double max_correction_deg = 0.0;
@@ -147,6 +153,7 @@ struct SunFusionOptions {
     v("innovation_gate_chi2", s.innovation_gate_chi2);
     v("evidence_sigmas", s.evidence_sigmas);
     v("evidence_forgetting", s.evidence_forgetting);
+    v("evidence_correlation", s.evidence_correlation);
     v("max_correction_deg", s.max_correction_deg);
   }
 };
