@@ -102,6 +102,13 @@ std::string summarize(const std::string& id, const std::string& name, const Trac
   const auto& fr = t.frames;
   const std::size_t n = fr.size();
   const Eigen::Vector3d e_end = fr.back().e_c / kDeg;
+  // Mean tilt error: the part of e_w across the world's up axis (roll and pitch), deg.
+  double tilt = 0.0;
+  for (const FrameTrace& f : fr) {
+    const Eigen::Vector3d up = t.route->world_up;
+    tilt += (f.e_w - up * up.dot(f.e_w)).norm() / kDeg;
+  }
+  tilt /= static_cast<double>(n);
   if (!sun) {
     // The largest per-frame jumps of the attitude error (|e_w,k - e_w,k-1|, world axes), with
     // the frame's number of stereo observations.
@@ -115,10 +122,12 @@ std::string summarize(const std::string& id, const std::string& name, const Trac
       jumps.push_back({j, k});
     }
     std::sort(jumps.rbegin(), jumps.rend());
-    std::snprintf(buf, sizeof(buf),
-                  "| %s | %s | final error (pitch x, yaw y, roll z) %.2f, %.2f, %.2f deg; sum of "
-                  "per-frame jumps %.2f deg; median observations per frame %.0f; largest:",
-                  id.c_str(), name.c_str(), e_end.x(), e_end.y(), e_end.z(), total, median(obs));
+    std::snprintf(
+        buf, sizeof(buf),
+        "| %s | %s | final error (pitch x, yaw y, roll z) %.2f, %.2f, %.2f deg; mean tilt "
+        "error %.2f deg; sum of per-frame jumps %.2f deg; median observations per frame "
+        "%.0f; largest:",
+        id.c_str(), name.c_str(), e_end.x(), e_end.y(), e_end.z(), tilt, total, median(obs));
     out += buf;
     for (std::size_t i = 0; i < std::min<std::size_t>(5, jumps.size()); ++i) {
       std::snprintf(buf, sizeof(buf), " %zu (%.2f deg, %zu obs)", jumps[i].second, jumps[i].first,
@@ -156,9 +165,10 @@ std::string summarize(const std::string& id, const std::string& name, const Trac
   const Eigen::Vector3d s_end = fr.back().sigma_c / kDeg;
   std::snprintf(
       buf, sizeof(buf),
-      "| %s | %s | %llu / %llu / %llu / %llu / %llu | %s | %.0f, %.0f, %.0f | %.2f, %.2f, %.2f "
+      "| %s | %s | %.2f | %llu / %llu / %llu / %llu / %llu | %s | %.0f, %.0f, %.0f | %.2f, %.2f, "
+      "%.2f "
       "| %.2f, %.2f, %.2f | %zu | %.3f | %.2f | %+.2f | %d |\n",
-      id.c_str(), name.c_str(), static_cast<unsigned long long>(g.accepted),
+      id.c_str(), name.c_str(), tilt, static_cast<unsigned long long>(g.accepted),
       static_cast<unsigned long long>(g.rejected_cosine),
       static_cast<unsigned long long>(g.rejected_vertical),
       static_cast<unsigned long long>(g.rejected_innovation),
@@ -177,7 +187,7 @@ int main(int argc, char** argv) {
   std::string sources_arg = "1,2,3,4";
   int frames = 0, seed = 1;
   std::optional<double> drift_deg, initial_sigma_deg, max_drift_deg, evidence_sigmas,
-      max_correction_deg, forgetting;
+      max_correction_deg, forgetting, zenith_bias_deg;
   bool fixed_drift = false, evidence = false;
   CLI::App app{"Traces the sun fusion's gate, covariance and corrections against ground truth.",
                kProgram};
@@ -205,6 +215,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.0, 1.0));
   app.add_option("--max-correction-deg", max_correction_deg, "correction gate, deg (0 = off)")
       ->check(CLI::Range(0.0, 180.0));
+  app.add_option("--zenith-bias-deg", zenith_bias_deg,
+                 "override the zenith bias of the Lalonde-like and Lalonde-VO-like models, deg")
+      ->check(CLI::Range(-45.0, 45.0));
   if (auto code = sunvo::cli::parse(app, argc, argv)) return *code;
 
   std::error_code ec;
@@ -222,18 +235,24 @@ int main(int argc, char** argv) {
   if (forgetting) options.fusion.persistence_forgetting = *forgetting;
   if (max_correction_deg) options.fusion.max_correction_deg = *max_correction_deg;
   if (auto s = options.validate(); !s.isOk()) return sunvo::cli::fail(kProgram, s);
-  const auto sources = sunvo::experiment::defaultSunSources(static_cast<std::uint32_t>(seed));
+  auto sources = sunvo::experiment::defaultSunSources(static_cast<std::uint32_t>(seed));
+  if (zenith_bias_deg) {
+    for (auto& src : sources) {
+      if (src.model.zenith_bias_deg != 0.0) src.model.zenith_bias_deg = *zenith_bias_deg;
+    }
+  }
 
   std::string metrics =
       "| route | run | final drift [m] (change) | rot. ARMSE [1e-3] (change) "
       "|\n|---|---|---|---|\n";
   std::string pure = "| route | run | pure VO attitude error |\n|---|---|---|\n";
   std::string table =
-      "| route | source | accepted / cosine / vertical / innovation / correction | NEES by quarter "
+      "| route | source | mean tilt error [deg] | accepted / cosine / vertical / innovation / "
+      "correction | NEES by quarter "
       "| mean "
       "z^2 (x, y, z) | final sigma [deg] (x, y, z) | final error [deg] (x, y, z) | corrections "
       "| median corr [deg] | sum corr [deg] | sum gain [deg] | corrections that helped |\n"
-      "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+      "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const std::string& spec : splitComma(routes_arg)) {
     sunvo::experiment::SimulatedRouteOptions sim;
     sim.seed = static_cast<std::uint32_t>(seed) + 6;
