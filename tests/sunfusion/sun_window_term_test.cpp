@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -299,6 +300,95 @@ TEST_F(SunWindowTermTest, PersistenceRuleIgnoresZeroMeanNoiseAndOutliers) {
   EXPECT_LT(logSO3(dC).norm() / kDeg, 0.5);
 }
 
+TEST_F(SunWindowTermTest, EvidenceRuleWidensPOnlyWhereTheErrorStandsOutOfTheNoise) {
+  // A 0.1 deg prior against a standing 2 deg base error. Precise measurements (0.57 deg) evidence
+  // the error within two windows: P must be widened to cover it. Imprecise ones (17 deg) evidence
+  // it at 0.5 sigma after 21 windows: P must stay as the random walk makes it.
+  SunFusionOptions opt = baseAttitudeOptions();
+  opt.initial_attitude_sigma_deg = 0.1;
+  opt.innovation_gate_chi2 = 0.0;
+  opt.drift_adaptation = DriftAdaptation::kEvidence;
+  SunWindowTerm precise, imprecise;
+  solvePreciseAndImprecise(opt, &precise, &imprecise);
+  EXPECT_GT(precise.numInflations(), 0u);
+  const auto max_sigma_deg = [](const SunWindowTerm& t) {
+    return std::sqrt(t.attitudeCovariance().eigenvalues().real().maxCoeff()) / kDeg;
+  };
+  EXPECT_GT(max_sigma_deg(precise), 0.5);
+  EXPECT_EQ(imprecise.numInflations(), 0u);
+  EXPECT_LT(max_sigma_deg(imprecise), 0.15);
+  // The random walk is not adapted by this rule.
+  EXPECT_EQ(precise.driftDegPerFrame(), opt.min_drift_deg_per_frame);
+  EXPECT_TRUE(precise.attitudeCovariance().allFinite());
+}
+
+TEST_F(SunWindowTermTest, EvidenceRuleDiscountsASourceWithCorrelatedErrors) {
+  // The precise measurements of the standing 2 deg error above, now from a source whose errors
+  // are stated to stay alike for 100 measurements: 21 of them count as less than one independent
+  // one, and P is not widened. A standing source bias looks exactly like this.
+  SunFusionOptions opt = baseAttitudeOptions();
+  opt.initial_attitude_sigma_deg = 0.1;
+  opt.innovation_gate_chi2 = 0.0;
+  opt.drift_adaptation = DriftAdaptation::kEvidence;
+  opt.evidence_correlation = 100.0;
+  SunWindowTerm correlated, unused;
+  solvePreciseAndImprecise(opt, &correlated, &unused);
+  EXPECT_EQ(correlated.numInflations(), 0u);
+  EXPECT_LT(std::sqrt(correlated.attitudeCovariance().eigenvalues().real().maxCoeff()) / kDeg,
+            0.15);
+}
+
+TEST_F(SunWindowTermTest, EvidenceRuleIgnoresZeroMeanNoiseAndOutliers) {
+  // As for the persistence rule: no attitude error, 11 deg noise and 20 % of 40 deg outliers.
+  T_w_b_est_ = Isometry3::Identity();
+  SunFusionOptions opt = baseAttitudeOptions();
+  opt.initial_attitude_sigma_deg = 0.5;
+  opt.innovation_gate_chi2 = 0.0;
+  opt.drift_adaptation = DriftAdaptation::kEvidence;
+  SunWindowTerm term;
+  ASSERT_TRUE(term.init(opt).isOk());
+  std::mt19937 rng(11);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (std::uint64_t k = 1; k <= 121; k += 2) {
+    SunObservation obs = perfectObservation(SunMeasurementKind::kFull3d, 0.2);
+    Eigen::Vector3d axis(normal(rng), normal(rng), normal(rng));
+    axis.normalize();
+    const double angle = unit(rng) < 0.2 ? 40.0 * kDeg : 0.2 * std::abs(normal(rng));
+    obs.measurement.sun_c = expSO3(angle * axis) * obs.measurement.sun_c;
+    solveAt(&term, k, obs);
+  }
+  EXPECT_EQ(term.numInflations(), 0u);
+  const Eigen::Matrix3d dC = window_.T_w_newest().linear() * T_k_b_true_.linear();
+  EXPECT_LT(logSO3(dC).norm() / kDeg, 0.5);
+}
+
+TEST_F(SunWindowTermTest, CorrectionGateRefusesAMeasurementThatWouldTurnTheAttitudeTooFar) {
+  // A 3 deg prior and a precise measurement of the 2 deg base error: the predicted correction is
+  // about 1.5 deg (the observable part). A 0.5 deg bound refuses it and counts it; 5 deg lets it
+  // in.
+  SunFusionOptions opt = baseAttitudeOptions();
+  opt.innovation_gate_chi2 = 0.0;
+  opt.max_correction_deg = 0.5;
+  SunWindowTerm bounded;
+  ASSERT_TRUE(bounded.init(opt).isOk());
+  const double before = solveAndYawError(nullptr, std::nullopt);
+  const double err_bounded =
+      solveAndYawError(&bounded, perfectObservation(SunMeasurementKind::kFull3d, 0.01));
+  EXPECT_EQ(bounded.counters().rejected_correction, 1u);
+  EXPECT_EQ(bounded.counters().accepted, 0u);
+  EXPECT_EQ(bounded.lastDecision(), GateResult::kRejectedCorrection);
+  EXPECT_NEAR(err_bounded, before, 1e-6);
+  opt.max_correction_deg = 5.0;
+  SunWindowTerm wide;
+  ASSERT_TRUE(wide.init(opt).isOk());
+  EXPECT_LT(solveAndYawError(&wide, perfectObservation(SunMeasurementKind::kFull3d, 0.01)),
+            0.5 * before);
+  EXPECT_EQ(wide.counters().accepted, 1u);
+  EXPECT_EQ(wide.numCorrections(), 1u);
+  EXPECT_GT(wide.lastCorrection().dtheta_w.norm() / kDeg, 0.5);
+}
+
 TEST_F(SunWindowTermTest, MedianRuleFollowsTheSizeOfTheInnovations) {
   // The comparison rule: precise measurements of a standing 2 deg error raise q_theta, imprecise
   // ones (innovations well inside S) lower it.
@@ -330,6 +420,18 @@ TEST(SunFusionOptionsTest, ValidationNamesTheBadKey) {
   opt = SunFusionOptions{};
   opt.innovation_gate_chi2 = -1.0;
   EXPECT_NE(opt.validate().toString().find("innovation_gate_chi2"), std::string::npos);
+  opt = SunFusionOptions{};
+  opt.evidence_sigmas = 0.0;
+  EXPECT_NE(opt.validate().toString().find("evidence_sigmas"), std::string::npos);
+  opt = SunFusionOptions{};
+  opt.evidence_forgetting = 1.0;
+  EXPECT_NE(opt.validate().toString().find("evidence_forgetting"), std::string::npos);
+  opt = SunFusionOptions{};
+  opt.evidence_correlation = 0.5;
+  EXPECT_NE(opt.validate().toString().find("evidence_correlation"), std::string::npos);
+  opt = SunFusionOptions{};
+  opt.max_correction_deg = -1.0;
+  EXPECT_NE(opt.validate().toString().find("max_correction_deg"), std::string::npos);
 }
 
 }  // namespace

@@ -32,6 +32,8 @@ const char* toString(GateResult r) {
       return "rejected: invalid measurement";
     case GateResult::kRejectedInnovation:
       return "rejected: innovation";
+    case GateResult::kRejectedCorrection:
+      return "rejected: correction too large";
   }
   return "unknown";
 }
@@ -55,6 +57,9 @@ void GateCounters::count(GateResult r) {
       break;
     case GateResult::kRejectedInnovation:
       ++rejected_innovation;
+      break;
+    case GateResult::kRejectedCorrection:
+      ++rejected_correction;
       break;
   }
 }

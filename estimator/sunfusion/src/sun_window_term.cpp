@@ -93,6 +93,18 @@ Status SunFusionOptions::validate() const {
   if (!(innovation_gate_chi2 >= 0.0 && innovation_gate_chi2 <= 1e6)) {
     return invalidArgument("fusion.innovation_gate_chi2 out of range [0, 1e6]");
   }
+  if (!(evidence_sigmas > 0.0 && evidence_sigmas <= 100.0)) {
+    return invalidArgument("fusion.evidence_sigmas out of range (0, 100]");
+  }
+  if (!(evidence_forgetting > 0.0 && evidence_forgetting < 1.0)) {
+    return invalidArgument("fusion.evidence_forgetting out of range (0, 1)");
+  }
+  if (!(evidence_correlation >= 1.0 && evidence_correlation <= 1000.0)) {
+    return invalidArgument("fusion.evidence_correlation out of range [1, 1000]");
+  }
+  if (!(max_correction_deg >= 0.0 && max_correction_deg <= 180.0)) {
+    return invalidArgument("fusion.max_correction_deg out of range [0, 180]");
+  }
   return Status::ok();
 }
 
@@ -107,7 +119,9 @@ Status SunWindowTerm::init(const SunFusionOptions& options) {
   delta_ = {0.0, 0.0, 0.0};
   const double s0 = options.initial_attitude_sigma_deg * kDeg;
   P_ = Eigen::Matrix3d::Identity() * s0 * s0;
-  drift_deg_per_frame_ = options.attitude_drift_deg_per_frame;
+  drift_deg_per_frame_ = options.drift_adaptation == DriftAdaptation::kEvidence
+                             ? options.min_drift_deg_per_frame
+                             : options.attitude_drift_deg_per_frame;
   persistence_g_.setZero();
   persistence_I_.setZero();
   persistence_T_ = 0.0;
@@ -118,6 +132,10 @@ Status SunWindowTerm::init(const SunFusionOptions& options) {
   }
   last_sequence_.reset();
   num_used_ = 0;
+  last_correction_ = Correction{};
+  num_corrections_ = 0;
+  last_nis_ = 0.0;
+  num_inflations_ = 0;
   return Status::ok();
 }
 
@@ -161,9 +179,13 @@ Status SunWindowTerm::onSolve(backend::BundleWindow& window) {
         cost_built = true;
         Innovation inn;
         const bool finite = innovation(*p.cost, window.T_k_b(s), P_b, &inn);
+        if (finite) last_nis_ = inn.nis;
         if (!finite ||
             (options_.innovation_gate_chi2 > 0.0 && inn.nis > options_.innovation_gate_chi2)) {
           r = GateResult::kRejectedInnovation;
+        } else if (options_.max_correction_deg > 0.0 &&
+                   inn.move_b.norm() > options_.max_correction_deg * kDeg) {
+          r = GateResult::kRejectedCorrection;
         } else {
           adaptDrift(inn, window.T_w_b().linear());
         }
@@ -216,6 +238,7 @@ void SunWindowTerm::onSolved(backend::BundleWindow& window) {
     info_b += J.transpose() * J;
   }
   const Eigen::Vector3d delta_b(delta_[0], delta_[1], delta_[2]);
+  const int used = num_used_;
   delta_ = {0.0, 0.0, 0.0};
   num_used_ = 0;
   if (!delta_b.allFinite() || !info_b.allFinite()) return;
@@ -230,6 +253,13 @@ void SunWindowTerm::onSolved(backend::BundleWindow& window) {
   if (!P_new.allFinite()) return;
   P_ = P_new;
   window.correctBaseAttitude(expSO3(delta_b));
+  const Eigen::Vector3d c_w = C_w_b * delta_b;
+  last_correction_ = {window.sequence(window.size() - 1), c_w, used};
+  ++num_corrections_;
+  // The evidence sums describe the error left: each innovation r_i ~ H_i e becomes H_i (e - c_w).
+  if (options_.drift_adaptation == DriftAdaptation::kEvidence) {
+    persistence_g_ -= persistence_I_ * c_w;
+  }
 }
 
 void SunWindowTerm::propagate(double frames) {
@@ -262,6 +292,10 @@ void SunWindowTerm::adaptDrift(const Innovation& inn, const Eigen::Matrix3d& C_w
       step = inn.nis > median ? options_.drift_adaptation_rate : -options_.drift_adaptation_rate;
       break;
     }
+    case DriftAdaptation::kEvidence:
+      accumulate(inn, C_w_b);
+      inflateToEvidence();
+      return;
     case DriftAdaptation::kPersistence: {
       // r ~ r0 + J delta_b and delta_b = C_b_w dtheta_w, so H = J C_b_w is the Jacobian wrt the
       // world-frame attitude error. If dtheta_w stayed constant while the filter ignores it, the
@@ -270,18 +304,7 @@ void SunWindowTerm::adaptDrift(const Innovation& inn, const Eigen::Matrix3d& C_w
       // T = g^T I^+ g with rank(I) dof when dtheta_w = 0 (noise only). The sums forget by
       // persistence_forgetting per measurement, so T weighs the recent drift; a Huber weight
       // caps an outlier's pull at persistence_huber sigmas per row.
-      // Fixed-size, with the rows past m zero (no heap allocation).
-      Eigen::Matrix3d J = inn.J;
-      Eigen::Vector3d r = inn.r;
-      J.bottomRows(3 - m).setZero();
-      r.tail(3 - m).setZero();
-      const Eigen::Matrix3d H = J * C_w_b.transpose();
-      const double cap = options_.persistence_huber * std::sqrt(static_cast<double>(m));
-      const double norm = r.norm();
-      const double w = norm > cap ? cap / norm : 1.0;
-      const double lambda = options_.persistence_forgetting;
-      persistence_g_ = lambda * persistence_g_ + H.transpose() * (w * r);
-      persistence_I_ = lambda * persistence_I_ + H.transpose() * H;
+      accumulate(inn, C_w_b);
       // Pseudo-inverse: one sun direction never informs the rotation about itself, and directions
       // with less than 1e-3 of the strongest information count as unobserved (rank drops).
       const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(persistence_I_);
@@ -307,6 +330,50 @@ void SunWindowTerm::adaptDrift(const Innovation& inn, const Eigen::Matrix3d& C_w
                                     options_.max_drift_deg_per_frame);
 }
 
+void SunWindowTerm::accumulate(const Innovation& inn, const Eigen::Matrix3d& C_w_b) {
+  // Fixed-size, with the rows past m zero (no heap allocation).
+  const int m = inn.dof;
+  Eigen::Matrix3d J = inn.J;
+  Eigen::Vector3d r = inn.r;
+  J.bottomRows(3 - m).setZero();
+  r.tail(3 - m).setZero();
+  const Eigen::Matrix3d H = J * C_w_b.transpose();
+  const double cap = options_.persistence_huber * std::sqrt(static_cast<double>(m));
+  const double norm = r.norm();
+  const double w = norm > cap ? cap / norm : 1.0;
+  const double lambda = options_.drift_adaptation == DriftAdaptation::kEvidence
+                            ? options_.evidence_forgetting
+                            : options_.persistence_forgetting;
+  persistence_g_ = lambda * persistence_g_ + H.transpose() * (w * r);
+  persistence_I_ = lambda * persistence_I_ + H.transpose() * H;
+}
+
+void SunWindowTerm::inflateToEvidence() {
+  // Along each well-informed direction v of I: e = v^T g / l estimates the error left, with
+  // variance 1/l under noise alone. A significant e that P does not cover (v^T P v < e^2) widens P
+  // along v to e^2, so that the following measurements may remove it; P never shrinks here.
+  // Directions with less than a tenth of the strongest information are left alone: an
+  // azimuth-only source barely informs some, and a few outliers would make e large there.
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(persistence_I_);
+  const double floor = 0.1 * std::max(eig.eigenvalues().maxCoeff(), 1e-300);
+  double T = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    const double l = eig.eigenvalues()(i);
+    if (!(l > floor)) continue;
+    const Eigen::Vector3d v = eig.eigenvectors().col(i);
+    const double e = v.dot(persistence_g_) / l;
+    T += e * e * l;
+    const double deficit = e * e - v.dot(P_ * v);
+    const double bound = options_.evidence_sigmas * options_.evidence_sigmas;
+    if (e * e * l > bound * options_.evidence_correlation && deficit > 0.0 &&
+        std::isfinite(deficit)) {
+      P_ += deficit * v * v.transpose();
+      ++num_inflations_;
+    }
+  }
+  persistence_T_ = T;
+}
+
 bool SunWindowTerm::innovation(const ceres::CostFunction& cost, const Isometry3& T_k_b,
                                const Eigen::Matrix3d& P_b, Innovation* out) {
   const double zero[3] = {0.0, 0.0, 0.0};
@@ -316,8 +383,10 @@ bool SunWindowTerm::innovation(const ceres::CostFunction& cost, const Isometry3&
   const RowsJacobian J = out->J.topRows(n);
   const RowsSquare S = J * P_b * J.transpose() + RowsSquare::Identity(n, n);
   const RowsVector rn = out->r.head(n);
-  out->nis = rn.dot(S.ldlt().solve(rn));
-  return std::isfinite(out->nis);
+  const RowsVector Sinv_r = S.ldlt().solve(rn);
+  out->nis = rn.dot(Sinv_r);
+  out->move_b = P_b * J.transpose() * Sinv_r;
+  return std::isfinite(out->nis) && out->move_b.allFinite();
 }
 
 }  // namespace sunvo::sunfusion

@@ -23,7 +23,7 @@ Status ExperimentOptions::validate() const {
 }
 
 Expected<RunResult> runRoute(const Route& route, const std::optional<SunSourceSpec>& spec,
-                             const ExperimentOptions& options) {
+                             const ExperimentOptions& options, const FrameObserver& observer) {
   SUNVO_RETURN_IF_ERROR(options.validate());
   std::size_t n = route.frames.size();
   if (options.max_frames > 0) n = std::min(n, static_cast<std::size_t>(options.max_frames));
@@ -73,6 +73,7 @@ Expected<RunResult> runRoute(const Route& route, const std::optional<SunSourceSp
     if (r->status == vo::TrackingStatus::kLost) ++result.lost_frames;
     ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
     result.T_w_c.push_back(r->T_w_c);
+    if (observer) observer(k, odometry);
   }
   result.gate = odometry.sunCounters();
   result.selfcal_pitch_mrad = selfcal.state()[0] * 1e3;

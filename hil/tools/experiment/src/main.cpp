@@ -55,11 +55,13 @@ int main(int argc, char** argv) {
   std::string routes_arg = "0020,00,06";
   int frames = 0, every = 5, seed = 1;
   std::optional<double> drift_deg, sun_loss, initial_sigma_deg, max_drift_deg, innovation_gate;
+  std::optional<double> evidence_sigmas, max_correction_deg;
   bool paper_form = false;
   bool write_poses = false;
   bool fixed_drift = false;
   bool self_calib = false;
   std::string drift_rule = "persistence";
+  std::string forms_arg = "sunvo";
   CLI::App app{
       "The paper's experiment: pure VO against VO + sun from several sun sources, per route.",
       kProgram};
@@ -79,12 +81,22 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.0, 5.0));
   app.add_option("--sun-loss", sun_loss, "Cauchy scale on the whitened sun residual (0 = none)")
       ->check(CLI::Range(0.0, 100.0));
-  app.add_flag("--paper-form", paper_form, "hold the base attitude fixed, as the paper did");
+  app.add_flag("--paper-form", paper_form,
+               "hold the base attitude fixed, as the paper did (same as --forms paper)");
+  app.add_option("--forms", forms_arg,
+                 "comma-separated fusion forms, each a column per source: sunvo (the base "
+                 "attitude is estimated), paper (held fixed, as the paper did)");
   app.add_flag("--fixed-drift", fixed_drift, "keep the random walk at --drift-deg");
   app.add_flag("--self-calib", self_calib,
                "online stereo self-calibration of the right camera before the odometry");
   app.add_option("--drift-rule", drift_rule, "how the random walk adapts")
-      ->check(CLI::IsMember({"persistence", "median", "fixed"}));
+      ->check(CLI::IsMember({"persistence", "median", "fixed", "evidence"}));
+  app.add_option("--evidence-sigmas", evidence_sigmas,
+                 "evidence rule: sigmas an error must reach before P covers it")
+      ->check(CLI::Range(0.0, 100.0));
+  app.add_option("--max-correction-deg", max_correction_deg,
+                 "refuse a measurement that would turn the attitude more, deg (0 = off)")
+      ->check(CLI::Range(0.0, 180.0));
   app.add_option("--innovation-gate", innovation_gate,
                  "chi-square bound of the innovation gate (0 = off)")
       ->check(CLI::Range(0.0, 1e6));
@@ -95,9 +107,10 @@ int main(int argc, char** argv) {
   app.add_option("--max-drift-deg", max_drift_deg,
                  "upper bound of the adapted random walk, deg/frame")
       ->check(CLI::Range(0.0, 5.0));
-  app.add_flag("--write-poses", write_poses,
-               "also write every run's poses and the ground truth as KITTI and TUM files "
-               "(route_<id>_gt, route_<id>_run<i>; run 0 is pure VO, then the sources)");
+  app.add_flag(
+      "--write-poses", write_poses,
+      "also write every run's poses and the ground truth as KITTI and TUM files "
+      "(route_<id>_gt, route_<id>_run<i>; run 0 is pure VO, then the sources, each in every form)");
   if (auto code = sunvo::cli::parse(app, argc, argv)) return *code;
 
   std::error_code ec;
@@ -115,15 +128,32 @@ int main(int argc, char** argv) {
   options.vo.window.max_solver_time_in_seconds = 60.0;
   if (drift_deg) options.fusion.attitude_drift_deg_per_frame = *drift_deg;
   if (sun_loss) options.fusion.loss_scale = *sun_loss;
-  options.fusion.estimate_base_attitude = !paper_form;
-  if (fixed_drift) options.fusion.drift_adaptation = sunvo::sunfusion::DriftAdaptation::kFixed;
+  if (paper_form) forms_arg = "paper";
+  const std::vector<std::string> forms = splitComma(forms_arg);
+  for (const std::string& f : forms) {
+    if (f != "sunvo" && f != "paper") {
+      std::fprintf(stderr, "%s: --forms: unknown form '%s' (sunvo, paper)\n", kProgram, f.c_str());
+      return sunvo::cli::kExitUsage;
+    }
+  }
+  if (forms.empty()) {
+    std::fprintf(stderr, "%s: --forms: no form given\n", kProgram);
+    return sunvo::cli::kExitUsage;
+  }
   if (initial_sigma_deg) options.fusion.initial_attitude_sigma_deg = *initial_sigma_deg;
   if (max_drift_deg) options.fusion.max_drift_deg_per_frame = *max_drift_deg;
-  if (drift_rule == "median") {
+  if (drift_rule == "persistence") {
+    options.fusion.drift_adaptation = sunvo::sunfusion::DriftAdaptation::kPersistence;
+  } else if (drift_rule == "median") {
     options.fusion.drift_adaptation = sunvo::sunfusion::DriftAdaptation::kInnovationMedian;
   } else if (drift_rule == "fixed") {
     options.fusion.drift_adaptation = sunvo::sunfusion::DriftAdaptation::kFixed;
+  } else if (drift_rule == "evidence") {
+    options.fusion.drift_adaptation = sunvo::sunfusion::DriftAdaptation::kEvidence;
   }
+  if (fixed_drift) options.fusion.drift_adaptation = sunvo::sunfusion::DriftAdaptation::kFixed;
+  if (evidence_sigmas) options.fusion.evidence_sigmas = *evidence_sigmas;
+  if (max_correction_deg) options.fusion.max_correction_deg = *max_correction_deg;
   if (innovation_gate) options.fusion.innovation_gate_chi2 = *innovation_gate;
   if (auto s = options.validate(); !s.isOk()) {
     std::fprintf(stderr, "%s: %s\n", kProgram, s.toString().c_str());
@@ -144,10 +174,20 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "route %s: %zu frames; %s\n", route->name.c_str(), route->frames.size(),
                  route->source.c_str());
     std::vector<RunResult> runs;
-    for (std::size_t s = 0; s <= sources.size(); ++s) {
-      std::optional<sunvo::experiment::SunSourceSpec> spec;
-      if (s > 0) spec = sources[s - 1];
-      auto run = sunvo::experiment::runRoute(*route, spec, options);
+    // Pure VO, then every source in every form (the paper's columns marked when both are shown).
+    std::vector<std::pair<std::optional<sunvo::experiment::SunSourceSpec>, bool>> plan = {
+        {std::nullopt, false}};
+    for (const auto& src : sources) {
+      for (const std::string& f : forms) {
+        sunvo::experiment::SunSourceSpec spec = src;
+        if (f == "paper" && forms.size() > 1) spec.name += " paper form";
+        plan.push_back({spec, f == "paper"});
+      }
+    }
+    for (const auto& [spec, paper] : plan) {
+      sunvo::experiment::ExperimentOptions run_options = options;
+      run_options.fusion.estimate_base_attitude = !paper;
+      auto run = sunvo::experiment::runRoute(*route, spec, run_options);
       if (!run) return sunvo::cli::fail(kProgram, route->name + ": " + run.status().toString());
       std::fprintf(stderr, "  %-28s done (%.2f ms/frame median, %d lost)\n", run->name.c_str(),
                    run->median_ms, run->lost_frames);

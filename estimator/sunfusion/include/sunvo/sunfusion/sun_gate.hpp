@@ -48,6 +48,7 @@ enum class GateResult {
   kRejectedSunDown,
   kRejectedInvalid,
   kRejectedInnovation,  // by the fusion's innovation gate (sun_window_term.hpp), not by this gate
+  kRejectedCorrection,  // would turn the attitude more than the fusion's max_correction_deg
 };
 
 const char* toString(GateResult r);
@@ -59,10 +60,11 @@ struct GateCounters {
   std::uint64_t rejected_sun_down = 0;
   std::uint64_t rejected_invalid = 0;
   std::uint64_t rejected_innovation = 0;
+  std::uint64_t rejected_correction = 0;
   void count(GateResult r);
   std::uint64_t total() const {
     return accepted + rejected_cosine + rejected_vertical + rejected_sun_down + rejected_invalid +
-           rejected_innovation;
+           rejected_innovation + rejected_correction;
   }
 };
 

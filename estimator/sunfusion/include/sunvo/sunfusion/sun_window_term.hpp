@@ -40,6 +40,17 @@
 //    * kInnovationMedian: one log-step up when a measurement's r^T S^-1 r exceeds the chi-square
 //      median of its rows, one down otherwise. With a correct R_s and P << R_s this rule walks
 //      at random, and outliers push it up: kept for comparison (docs/experiment.md).
+//    * kEvidence (covariance matching): q_theta stays at min_drift_deg_per_frame, and P is
+//      made to cover the error the measurements evidence. The sums I and g are kept consistent
+//      with the estimate (after a correction c_w, g <- g - I c_w, so they describe the error that
+//      is left); they forget by evidence_forgetting. Along each eigen-direction v of I with
+//      eigenvalue l of at least a tenth of the largest, e = v^T g / l estimates the
+//      remaining world attitude error with variance tau/l (tau = evidence_correlation, the
+//      source's error correlation length in measurements); when |e| > evidence_sigmas sqrt(tau/l),
+//      P grows by (e^2 - v^T P v) v v^T where that is positive. With R_s >> P a single
+//      innovation cannot tell P is too small (docs/experiment.md, measured), about 50 of them can.
+//  - Correction gate: with max_correction_deg > 0 a measurement whose predicted correction
+//    |P_b J^T S^-1 r| exceeds that bound is refused (kRejectedCorrection) and counted.
 //  - Innovation gate: besides the fixed gate of sun_gate.hpp, with innovation_gate_chi2 > 0 a
 //    measurement is rejected when its whitened innovation r (at delta = 0) has
 //    r^T (J P_b J^T + I)^-1 r above that bound: once the filter is confident, shadow flips and
@@ -67,9 +78,10 @@ struct SunObservation {
   Eigen::Vector3d sun_w = Eigen::Vector3d::UnitZ();  // unit vector toward the sun, VO world frame
 };
 
-enum class DriftAdaptation { kFixed, kPersistence, kInnovationMedian };
+enum class DriftAdaptation { kFixed, kPersistence, kInnovationMedian, kEvidence };
 inline std::span<const std::string_view> enumNames(DriftAdaptation) {
-  static constexpr std::string_view kNames[] = {"fixed", "persistence", "innovation_median"};
+  static constexpr std::string_view kNames[] = {"fixed", "persistence", "innovation_median",
+                                                "evidence"};
   return kNames;
 }
 
@@ -107,6 +119,19 @@ struct SunFusionOptions {
   double persistence_huber = 2.0;
   // Innovation gate bound on r^T S^-1 r, [0, 1e6]; 0 = off. 16.3 = chi-square 3 dof, 99.9 %.
   double innovation_gate_chi2 = 16.3;
+  // Evidence rule: how many standard deviations of its estimate an error must reach along a
+  // direction before P is made to cover it, (0, 100]; forgetting factor of its sums per accepted
+  // measurement, (0, 1) (0.99: about the last 100). Uses persistence_huber.
+  double evidence_sigmas = 3.0;
+  double evidence_forgetting = 0.99;
+  // Evidence rule: the source's error correlation length in measurements, [1, 1000]. The test
+  // assumes independent errors; an estimator whose errors stay alike for tau measurements (a
+  // street-long bias) gives about 1/tau as many independent ones, so the estimate's variance is
+  // taken tau times larger (decorrelation in time). 1 = independent (the error models).
+  double evidence_correlation = 1.0;
+  // deg, [0, 180]; 0 = off: refuse a measurement whose predicted correction of the attitude is
+  // larger (counted as rejected_correction).
+  double max_correction_deg = 0.0;
 
   Status validate() const;
   template <class Self, class V>
@@ -126,6 +151,10 @@ struct SunFusionOptions {
     v("persistence_step_down", s.persistence_step_down);
     v("persistence_huber", s.persistence_huber);
     v("innovation_gate_chi2", s.innovation_gate_chi2);
+    v("evidence_sigmas", s.evidence_sigmas);
+    v("evidence_forgetting", s.evidence_forgetting);
+    v("evidence_correlation", s.evidence_correlation);
+    v("max_correction_deg", s.max_correction_deg);
   }
 };
 
@@ -146,6 +175,20 @@ class SunWindowTerm {
   double driftDegPerFrame() const { return drift_deg_per_frame_; }
   // Last value of the persistence statistic T (0 before the first accepted measurement).
   double persistenceStatistic() const { return persistence_T_; }
+  // The last correction of the base's world attitude (base-attitude mode), for diagnostics:
+  // dtheta_w = C_w_b delta_b (rad, world frame; the VO world attitude turns by Exp(dtheta_w)),
+  // the newest frame of the solve that made it, and how many measurements it used.
+  struct Correction {
+    std::uint64_t sequence = 0;
+    Eigen::Vector3d dtheta_w = Eigen::Vector3d::Zero();
+    int measurements = 0;
+  };
+  const Correction& lastCorrection() const { return last_correction_; }
+  std::uint64_t numCorrections() const { return num_corrections_; }
+  // r^T S^-1 r of the last measurement that reached the innovation gate (0 before the first).
+  double lastInnovationNis() const { return last_nis_; }
+  // Evidence rule: how often P was widened to cover an evidenced error.
+  std::uint64_t numInflations() const { return num_inflations_; }
 
  private:
   struct Pending {
@@ -172,11 +215,16 @@ class SunWindowTerm {
         Eigen::Matrix<double, 3, 3, Eigen::RowMajor>::Zero();
     int dof = 0;
     double nis = 0.0;
+    Eigen::Vector3d move_b = Eigen::Vector3d::Zero();  // predicted correction P_b J^T S^-1 r
   };
   static bool innovation(const ceres::CostFunction& cost, const Isometry3& T_k_b,
                          const Eigen::Matrix3d& P_b, Innovation* out);
   // One adaptation step of q_theta from an accepted measurement's innovation (C_w_b: base).
   void adaptDrift(const Innovation& inn, const Eigen::Matrix3d& C_w_b);
+  // Adds an accepted measurement to the forgotten sums I and g (world frame).
+  void accumulate(const Innovation& inn, const Eigen::Matrix3d& C_w_b);
+  // Evidence rule: widens P along directions where I^+ g stands out of its noise.
+  void inflateToEvidence();
 
   SunFusionOptions options_;
   std::unique_ptr<ceres::LossFunction> loss_;
@@ -196,6 +244,10 @@ class SunWindowTerm {
   std::unique_ptr<ceres::CostFunction> prior_cost_;
   std::array<int, backend::BundleWindow::kMaxWindowSize> used_in_solve_{};  // ring indices
   int num_used_ = 0;
+  Correction last_correction_;
+  std::uint64_t num_corrections_ = 0;
+  double last_nis_ = 0.0;
+  std::uint64_t num_inflations_ = 0;
 };
 
 }  // namespace sunvo::sunfusion

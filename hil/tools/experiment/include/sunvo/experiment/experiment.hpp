@@ -12,6 +12,7 @@
 // Sun measurements are made every `every_n_frames` frames from the truth through a sun source:
 // the true vector itself ("ground truth"), or an error model emulating an image estimator.
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -20,6 +21,7 @@
 #include "sunvo/core/features.hpp"
 #include "sunvo/core/geometry.hpp"
 #include "sunvo/metrics/metrics.hpp"
+#include "sunvo/pipeline/sun_aided_odometry.hpp"
 #include "sunvo/selfcal/stereo_self_calibration.hpp"
 #include "sunvo/sunfusion/simulated_sun_source.hpp"
 #include "sunvo/sunfusion/sun_gate.hpp"
@@ -76,9 +78,13 @@ struct RunResult {
   metrics::Evaluation evaluation;
 };
 
+// Called after frame k was processed, with the odometry (its pose, sun counters, attitude
+// covariance): traces and diagnostics (sunvo_fusion_trace).
+using FrameObserver = std::function<void(std::size_t k, const pipeline::SunAidedOdometry&)>;
+
 // Runs pure VO (spec == nullopt) or VO + sun from one source over the route.
 Expected<RunResult> runRoute(const Route& route, const std::optional<SunSourceSpec>& spec,
-                             const ExperimentOptions& options);
+                             const ExperimentOptions& options, const FrameObserver& observer = {});
 
 // The sun sources of the built-in experiment: the true vector, and error models emulating the
 // paper's three image estimators (Lalonde, Lalonde-VO, Sun-CNN). The models' statistics are our
