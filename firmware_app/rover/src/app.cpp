@@ -191,6 +191,7 @@ Expected<std::unique_ptr<RoverApp>> RoverApp::create(const RoverConfig& config,
     impl->sun =
         std::make_unique<SunStage>(*impl->ctx, impl->attitude, std::move(*provider), world->origin);
   }
+  if (link) link->setWorldOrigin(world->origin.lat_deg, world->origin.lon_deg, world->origin.alt_m);
   impl->telemetry = std::make_unique<TelemetryStage>(*impl->ctx, std::move(link));
   const auto warmup = static_cast<std::uint64_t>(config.realtime.warmup_frames);
   impl->capture->meter().setWarmup(warmup);
