@@ -61,8 +61,13 @@ TEST(RoverConfig, DefaultsAndOverrides) {
                                   {"sun.provider", "csv"},
                                   {"sun.csv", "/data/sun.csv"},
                                   {"estimator.fusion.gate.plane", "xz"},
-                                  {"estimator.frontend.max_features", "1500"}});
+                                  {"estimator.frontend.max_features", "1500"},
+                                  {"telemetry.frame", "ardupilot"},
+                                  {"telemetry.position_sigma_per_m", "0.05"}});
   ASSERT_TRUE(c) << c.status().toString();
+  EXPECT_EQ(c->telemetry.frame, mavlink::FrameProfile::kArduPilot);
+  EXPECT_DOUBLE_EQ(c->telemetry.position_sigma_per_m, 0.05);
+  EXPECT_DOUBLE_EQ(c->telemetry.origin_period_s, 10.0);  // default
   // The estimator section is the estimator's own options struct: its field names are the keys.
   EXPECT_EQ(c->estimator.pipeline.vo.window.max_num_iterations, 12);
   EXPECT_EQ(c->estimator.pipeline.vo.window.window_size, 2);  // default
@@ -81,6 +86,10 @@ TEST(RoverConfig, DefaultsAndOverrides) {
   EXPECT_NE(text.find("  estimator.fusion.gate.plane: xz\n"), std::string::npos);
   EXPECT_NE(text.find("  rt.threads.capture.fifo_priority: 80\n"), std::string::npos);
   EXPECT_NE(text.find("  source.kitti.end: stop\n"), std::string::npos);
+  EXPECT_NE(text.find("  telemetry.frame: ardupilot\n"), std::string::npos);
+  auto px4 = loadRoverConfig(path);
+  ASSERT_TRUE(px4) << px4.status().toString();
+  EXPECT_EQ(px4->telemetry.frame, mavlink::FrameProfile::kPx4);  // the default
 }
 
 TEST(RoverConfig, ErrorsNameTheFileTheKeyAndTheLine) {
@@ -105,6 +114,15 @@ TEST(RoverConfig, ErrorsNameTheFileTheKeyAndTheLine) {
   auto t = loadRoverConfig(typed);
   ASSERT_FALSE(t);
   EXPECT_EQ(t.status().message(), typed + ":7: estimator.every_n_frames: expected an integer");
+
+  auto frame = loadRoverConfig(path, {{"telemetry.frame", "mavros"}});
+  ASSERT_FALSE(frame);
+  EXPECT_NE(frame.status().message().find("telemetry.frame: 'mavros' is not one of px4, ardupilot"),
+            std::string::npos)
+      << frame.status().message();
+  auto k = loadRoverConfig(path, {{"telemetry.position_sigma_per_m", "1.5"}});
+  ASSERT_FALSE(k);
+  EXPECT_NE(k.status().message().find("telemetry.position_sigma_per_m"), std::string::npos);
 
   auto e = loadRoverConfig(path, {{"source.kitti.end", "rewind"}});
   ASSERT_FALSE(e);

@@ -112,6 +112,27 @@ std::string odometryJson(const Odometry& m, std::uint8_t seq, const Endpoint& fr
   return entry(kMsgIdOdometry, seq, from, f.str());
 }
 
+std::string originJson(const SetGpsGlobalOrigin& m, std::uint8_t seq, const Endpoint& from) {
+  std::ostringstream f;
+  f << "\"latitude\":" << m.latitude << ",\"longitude\":" << m.longitude
+    << ",\"altitude\":" << m.altitude << ",\"targetSystem\":" << int{m.target_system}
+    << ",\"timeUsec\":\"" << m.time_usec << "\"";
+  return entry(kMsgIdSetGpsGlobalOrigin, seq, from, f.str());
+}
+
+// text: printable ASCII without quotes or backslashes (the test's own strings).
+std::string statusTextJson(const StatusText& m, std::uint8_t seq, const Endpoint& from) {
+  std::string text;
+  for (char c : m.text) {
+    if (c == '\0') break;
+    text += c;
+  }
+  std::ostringstream f;
+  f << "\"severity\":" << int{m.severity} << ",\"text\":\"" << text << "\",\"id\":" << m.id
+    << ",\"chunkSeq\":" << int{m.chunk_seq};
+  return entry(kMsgIdStatusText, seq, from, f.str());
+}
+
 void writeJsonArray(const std::string& path, const std::vector<std::string>& entries) {
   std::ofstream os(path);
   os << "[\n";
@@ -168,6 +189,29 @@ TEST(NodeMavlink, EncoderMatchesNodeMavlinkSerializerByteForByte) {
   truncated.velocity_covariance.fill(0.0f);
   truncated.velocity_covariance[3] = 0.5f;
   addOdometry(truncated, 9, Endpoint{});
+  // SET_GPS_GLOBAL_ORIGIN: negative longitude, time_usec set and 0 (cut to 13 B).
+  SetGpsGlobalOrigin origin;
+  origin.latitude = 490'112'345;
+  origin.longitude = -123'456'789;
+  origin.altitude = 112'500;
+  origin.time_usec = 1'317'380'000'123'456ULL;
+  entries.push_back(originJson(origin, 10, Endpoint{}));
+  ours.push_back(hex(buf, encodeSetGpsGlobalOrigin(origin, Endpoint{}, 10, buf)));
+  origin.time_usec = 0;
+  origin.target_system = 7;
+  entries.push_back(originJson(origin, 11, Endpoint{}));
+  ours.push_back(hex(buf, encodeSetGpsGlobalOrigin(origin, Endpoint{}, 11, buf)));
+  // STATUSTEXT: a short text (cut after it) and one of exactly 50 chars with id/chunk set.
+  StatusText text;
+  text.severity = kMavSeverityCritical;
+  setStatusText("sunvo: VO tracking lost", &text);
+  entries.push_back(statusTextJson(text, 12, Endpoint{}));
+  ours.push_back(hex(buf, encodeStatusText(text, Endpoint{}, 12, buf)));
+  setStatusText("0123456789abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMN", &text);
+  text.id = 513;
+  text.chunk_seq = 2;
+  entries.push_back(statusTextJson(text, 13, Endpoint{}));
+  ours.push_back(hex(buf, encodeStatusText(text, Endpoint{}, 13, buf)));
 
   const std::string input = kNodeDir + "/serialize_input_" + std::to_string(::getpid()) + ".json";
   writeJsonArray(input, entries);
@@ -186,7 +230,13 @@ TEST(NodeMavlink, EncoderMatchesNodeMavlinkSerializerByteForByte) {
   EXPECT_EQ(i, ours.size());
   // The truncated frame is 10 + 160 + 2 bytes: the payload ends with velocity_covariance[3]
   // (offset 144 + 12 .. 159); node-mavlink cuts the same zeros.
-  EXPECT_EQ(ours.back().size(), 2u * (kHeaderBytes + 160 + kChecksumBytes));
+  EXPECT_EQ(ours[4].size(), 2u * (kHeaderBytes + 160 + kChecksumBytes));
+  // time_usec < 2^56: its top byte is zero and cut, 20 of 21 bytes remain.
+  EXPECT_EQ(ours[5].size(),
+            2u * (kHeaderBytes + kPayloadBytesSetGpsGlobalOrigin - 1 + kChecksumBytes));
+  EXPECT_EQ(ours[6].size(), 2u * (kHeaderBytes + 13 + kChecksumBytes));  // time_usec 0 cut
+  EXPECT_EQ(ours[7].size(), 2u * (kHeaderBytes + 1 + 23 + kChecksumBytes));
+  EXPECT_EQ(ours[8].size(), 2u * (kHeaderBytes + kPayloadBytesStatusText + kChecksumBytes));
 }
 
 // The stream: a rover driving a 20 m circle in ENU at 10 Hz for 6 s of simulated time.

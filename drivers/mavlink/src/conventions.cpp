@@ -121,4 +121,9 @@ Odometry toOdometry(const OdometryInput& in, WorldConvention world, const Eigen:
   return out;
 }
 
+void applyProfile(FrameProfile profile, Odometry* odo) {
+  odo->child_frame_id = kMavFrameBodyFrd;
+  if (profile == FrameProfile::kArduPilot) odo->frame_id = kMavFrameLocalFrd;
+}
+
 }  // namespace sunvo::mavlink

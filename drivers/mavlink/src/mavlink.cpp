@@ -50,6 +50,12 @@ bool crcExtraFor(std::uint32_t msgid, std::uint8_t* crc_extra) {
     case kMsgIdOdometry:
       *crc_extra = kCrcExtraOdometry;
       return true;
+    case kMsgIdSetGpsGlobalOrigin:
+      *crc_extra = kCrcExtraSetGpsGlobalOrigin;
+      return true;
+    case kMsgIdStatusText:
+      *crc_extra = kCrcExtraStatusText;
+      return true;
     default:
       return false;
   }
@@ -262,6 +268,58 @@ bool decodeOdometry(const Frame& frame, Odometry* out) {
   out->reset_counter = p[odo::kResetCounter];
   out->estimator_type = p[odo::kEstimatorType];
   out->quality = static_cast<std::int8_t>(p[odo::kQuality]);
+  return true;
+}
+
+std::size_t encodeSetGpsGlobalOrigin(const SetGpsGlobalOrigin& msg, const Endpoint& from,
+                                     std::uint8_t seq, std::uint8_t* out) {
+  std::uint8_t* p = out + kHeaderBytes;
+  putU32(p, 0, static_cast<std::uint32_t>(msg.latitude));
+  putU32(p, 4, static_cast<std::uint32_t>(msg.longitude));
+  putU32(p, 8, static_cast<std::uint32_t>(msg.altitude));
+  putU8(p, 12, msg.target_system);
+  putU64(p, 13, msg.time_usec);
+  return finishFrame(kMsgIdSetGpsGlobalOrigin, kCrcExtraSetGpsGlobalOrigin,
+                     kPayloadBytesSetGpsGlobalOrigin, from, seq, out);
+}
+
+void setStatusText(const char* text, StatusText* msg) {
+  msg->text.fill('\0');
+  for (std::size_t i = 0; i < kStatusTextChars && text[i] != '\0'; ++i) msg->text[i] = text[i];
+}
+
+std::size_t encodeStatusText(const StatusText& msg, const Endpoint& from, std::uint8_t seq,
+                             std::uint8_t* out) {
+  std::uint8_t* p = out + kHeaderBytes;
+  putU8(p, 0, msg.severity);
+  for (std::size_t i = 0; i < kStatusTextChars; ++i) {
+    putU8(p, 1 + i, static_cast<std::uint8_t>(msg.text[i]));
+  }
+  putU8(p, 51, static_cast<std::uint8_t>(msg.id & 0xFF));
+  putU8(p, 52, static_cast<std::uint8_t>(msg.id >> 8));
+  putU8(p, 53, msg.chunk_seq);
+  return finishFrame(kMsgIdStatusText, kCrcExtraStatusText, kPayloadBytesStatusText, from, seq,
+                     out);
+}
+
+bool decodeSetGpsGlobalOrigin(const Frame& frame, SetGpsGlobalOrigin* out) {
+  if (frame.msgid != kMsgIdSetGpsGlobalOrigin) return false;
+  const std::uint8_t* p = frame.payload.data();
+  out->latitude = static_cast<std::int32_t>(getU32(p, 0));
+  out->longitude = static_cast<std::int32_t>(getU32(p, 4));
+  out->altitude = static_cast<std::int32_t>(getU32(p, 8));
+  out->target_system = p[12];
+  out->time_usec = getU64(p, 13);
+  return true;
+}
+
+bool decodeStatusText(const Frame& frame, StatusText* out) {
+  if (frame.msgid != kMsgIdStatusText) return false;
+  const std::uint8_t* p = frame.payload.data();
+  out->severity = p[0];
+  for (std::size_t i = 0; i < kStatusTextChars; ++i) out->text[i] = static_cast<char>(p[1 + i]);
+  out->id = static_cast<std::uint16_t>(p[51] | (p[52] << 8));
+  out->chunk_seq = p[53];
   return true;
 }
 

@@ -203,6 +203,7 @@ Expected<std::unique_ptr<RoverApp>> RoverApp::create(const RoverConfig& config,
       return Status(opened.status().code(), "telemetry.pose_log: " + opened.status().message());
     pose_log = std::move(*opened);
   }
+  if (link) link->setWorldOrigin(world->origin.lat_deg, world->origin.lon_deg, world->origin.alt_m);
   impl->telemetry =
       std::make_unique<TelemetryStage>(*impl->ctx, std::move(link), std::move(pose_log));
   const auto warmup = static_cast<std::uint64_t>(config.realtime.warmup_frames);

@@ -338,6 +338,14 @@ Status RoverConfig::validate() const {
   SUNVO_RETURN_IF_ERROR(
       checkRange("telemetry.full_quality_inliers", telemetry.full_quality_inliers, 1, 100000));
   SUNVO_RETURN_IF_ERROR(
+      checkRange("telemetry.position_sigma_per_m", telemetry.position_sigma_per_m, 0.0, 1.0));
+  SUNVO_RETURN_IF_ERROR(
+      checkRange("telemetry.origin_period_s", telemetry.origin_period_s, 0.0, 3600.0));
+  SUNVO_RETURN_IF_ERROR(checkRange("telemetry.statustext_min_interval_s",
+                                   telemetry.statustext_min_interval_s, 0.0, 60.0));
+  SUNVO_RETURN_IF_ERROR(
+      checkOpenLow("telemetry.pose_timeout_s", telemetry.pose_timeout_s, 0.0, 60.0));
+  SUNVO_RETURN_IF_ERROR(
       checkRange("telemetry.pose_log_buffer_kb", telemetry.pose_log_buffer_kb, 1, 65536));
   SUNVO_RETURN_IF_ERROR(checkRange("rt.heap_reserve_mb", rt.heap_reserve_mb, 0, 4096));
   SUNVO_RETURN_IF_ERROR(rt.threads.capture.validate("rt.threads.capture"));

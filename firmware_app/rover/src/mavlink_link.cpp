@@ -4,12 +4,14 @@
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "sunvo/vo/stereo_track_odometry.hpp"
 
 namespace sunvo::rover {
 
-mavlink::OdometryInput odometryInput(const PoseRecord& pose, const TelemetryConfig& telemetry) {
+mavlink::OdometryInput odometryInput(const PoseRecord& pose, const TelemetryConfig& telemetry,
+                                     double distance_m) {
   mavlink::OdometryInput in;
   in.time_ns = pose.utc_ns;
   in.T_w_c.translation() = Eigen::Vector3d(pose.p_w[0], pose.p_w[1], pose.p_w[2]);
@@ -39,15 +41,31 @@ mavlink::OdometryInput odometryInput(const PoseRecord& pose, const TelemetryConf
       break;
   }
   if (status != vo::TrackingStatus::kLost) {
-    const double inflate = status == vo::TrackingStatus::kRecovered ? 10.0 : 1.0;
-    const double s_rot = telemetry.attitude_sigma_deg * M_PI / 180.0 * inflate;
-    const double s_pos = telemetry.position_sigma_m * inflate;
     in.cov_pose.setZero();  // [dtheta_w; dp_w]
-    in.cov_pose.diagonal() << s_rot * s_rot, s_rot * s_rot, s_rot * s_rot, s_pos * s_pos,
-        s_pos * s_pos, s_pos * s_pos;
+    if (pose.cov_theta_valid) {
+      const double* u = pose.cov_theta_w;  // xx xy xz yy yz zz
+      in.cov_pose.topLeftCorner<3, 3>() << u[0], u[1], u[2], u[1], u[3], u[4], u[2], u[4], u[5];
+    } else {
+      const double s_rot = telemetry.attitude_sigma_deg * M_PI / 180.0;
+      in.cov_pose.topLeftCorner<3, 3>().diagonal().setConstant(s_rot * s_rot);
+    }
+    // sigma_p = sigma_0 + k * distance: VO position error grows roughly in proportion to the
+    // path length; the same sigma on each axis.
+    const double s_pos = telemetry.position_sigma_m + telemetry.position_sigma_per_m * distance_m;
+    in.cov_pose.bottomRightCorner<3, 3>().diagonal().setConstant(s_pos * s_pos);
   }
   in.reset_counter = pose.reset_counter;
   return in;
+}
+
+mavlink::SetGpsGlobalOrigin globalOrigin(double lat_deg, double lon_deg, double alt_m) {
+  mavlink::SetGpsGlobalOrigin o;
+  o.latitude = static_cast<std::int32_t>(std::lround(lat_deg * 1e7));
+  o.longitude = static_cast<std::int32_t>(std::lround(lon_deg * 1e7));
+  o.altitude = static_cast<std::int32_t>(std::lround(alt_m * 1e3));
+  o.target_system = 0;  // broadcast: the autopilot's system id is not configured
+  o.time_usec = 0;
+  return o;
 }
 
 MavlinkSerialLink::MavlinkSerialLink(std::unique_ptr<serial::SerialPort> port,
@@ -69,31 +87,109 @@ Expected<std::unique_ptr<MavlinkSerialLink>> MavlinkSerialLink::open(
 }
 
 Status MavlinkSerialLink::sendPose(const PoseRecord& pose, TimeNs now_mono_ns) {
-  const mavlink::Odometry odo =
-      mavlink::toOdometry(odometryInput(pose, telemetry_), mavlink::WorldConvention::kEnu, C_b_c_);
+  const auto status = static_cast<vo::TrackingStatus>(pose.tracking);
+  const Eigen::Vector3d p_w(pose.p_w[0], pose.p_w[1], pose.p_w[2]);
+  if (status == vo::TrackingStatus::kTracking && have_last_p_ && p_w.allFinite()) {
+    distance_m_ += (p_w - last_p_w_).norm();
+  }
+  // A recovered frame restarts the chain: its jump is not distance travelled.
+  have_last_p_ = status != vo::TrackingStatus::kLost && p_w.allFinite();
+  if (have_last_p_) last_p_w_ = p_w;
+  const bool lost = status == vo::TrackingStatus::kLost;
+  if (lost && !lost_) queueText(mavlink::kMavSeverityCritical, "sunvo: VO tracking lost");
+  if (status == vo::TrackingStatus::kRecovered) {
+    char text[mavlink::kStatusTextChars + 1];
+    std::snprintf(text, sizeof(text), "sunvo: VO recovered, reset %u",
+                  static_cast<unsigned>(pose.reset_counter));
+    queueText(mavlink::kMavSeverityNotice, text);
+  }
+  lost_ = lost;
+
+  mavlink::Odometry odo = mavlink::toOdometry(odometryInput(pose, telemetry_, distance_m_),
+                                              mavlink::WorldConvention::kEnu, C_b_c_);
+  mavlink::applyProfile(telemetry_.frame, &odo);
   const std::size_t n = mavlink::encodeOdometry(odo, endpoint_, seq_++, buffer_.data());
-  return port_->send(buffer_.data(), n, now_mono_ns);
+  Status st = port_->send(buffer_.data(), n, now_mono_ns);
+  const Status text_st = sendPendingText(now_mono_ns);
+  return st.isOk() ? text_st : st;
 }
 
 Status MavlinkSerialLink::sendHeartbeat(TimeNs now_mono_ns) {
+  mavlink::Heartbeat hb;
+  hb.system_status = lost_ || stale_ ? mavlink::kMavStateCritical : mavlink::kMavStateActive;
+  const std::size_t n = mavlink::encodeHeartbeat(hb, endpoint_, seq_++, buffer_.data());
+  return port_->send(buffer_.data(), n, now_mono_ns);
+}
+
+Status MavlinkSerialLink::sendOrigin(TimeNs now_mono_ns) {
   const std::size_t n =
-      mavlink::encodeHeartbeat(mavlink::Heartbeat{}, endpoint_, seq_++, buffer_.data());
+      mavlink::encodeSetGpsGlobalOrigin(origin_, endpoint_, seq_++, buffer_.data());
+  ++origins_sent_;
+  return port_->send(buffer_.data(), n, now_mono_ns);
+}
+
+void MavlinkSerialLink::setWorldOrigin(double lat_deg, double lon_deg, double alt_m) {
+  origin_ = globalOrigin(lat_deg, lon_deg, alt_m);
+  have_origin_ = true;
+  next_origin_ns_ = 0;  // at the next service()
+}
+
+void MavlinkSerialLink::setPoseStale(bool stale, TimeNs now_mono_ns) {
+  if (stale == stale_) return;
+  stale_ = stale;
+  if (stale) {
+    char text[mavlink::kStatusTextChars + 1];
+    std::snprintf(text, sizeof(text), "sunvo: no pose for %.1f s", telemetry_.pose_timeout_s);
+    queueText(mavlink::kMavSeverityError, text);
+  } else {
+    queueText(mavlink::kMavSeverityInfo, "sunvo: poses resumed");
+  }
+  (void)sendPendingText(now_mono_ns);
+}
+
+void MavlinkSerialLink::queueText(std::uint8_t severity, const char* text) {
+  pending_text_.severity = severity;
+  mavlink::setStatusText(text, &pending_text_);
+  text_pending_ = true;
+}
+
+Status MavlinkSerialLink::sendPendingText(TimeNs now_mono_ns) {
+  if (!text_pending_) return Status::ok();
+  const auto min_gap = static_cast<TimeNs>(telemetry_.statustext_min_interval_s * 1e9);
+  if (text_sent_once_ && now_mono_ns - last_text_ns_ < min_gap) return Status::ok();
+  const std::size_t n = mavlink::encodeStatusText(pending_text_, endpoint_, seq_++, buffer_.data());
+  text_pending_ = false;
+  text_sent_once_ = true;
+  last_text_ns_ = now_mono_ns;
+  ++texts_sent_;
   return port_->send(buffer_.data(), n, now_mono_ns);
 }
 
 Status MavlinkSerialLink::service(TimeNs now_mono_ns) {
-  return port_->flush(now_mono_ns);
+  Status st = Status::ok();
+  if (have_origin_ && now_mono_ns >= next_origin_ns_) {
+    st = sendOrigin(now_mono_ns);
+    next_origin_ns_ = telemetry_.origin_period_s > 0.0
+                          ? now_mono_ns + static_cast<TimeNs>(telemetry_.origin_period_s * 1e9)
+                          : std::numeric_limits<TimeNs>::max();
+  }
+  const Status text_st = sendPendingText(now_mono_ns);
+  const Status flush_st = port_->flush(now_mono_ns);
+  if (!st.isOk()) return st;
+  return text_st.isOk() ? flush_st : text_st;
 }
 
 std::string MavlinkSerialLink::countersText() const {
   const serial::SerialCounters& c = port_->counters();
-  char line[320];
+  char line[400];
   std::snprintf(line, sizeof(line),
                 "%s: frames queued %" PRIu64 ", written %" PRIu64 ", dropped %" PRIu64
                 ", bytes written %" PRIu64 ", would-block %" PRIu64 ", write errors %" PRIu64
-                ", reopens %" PRIu64,
+                ", reopens %" PRIu64 "; origins %" PRIu64 ", status texts %" PRIu64
+                ", distance %.1f m",
                 port_->options().device.c_str(), c.frames_queued, c.frames_written,
-                c.frames_dropped, c.bytes_written, c.write_would_block, c.write_errors, c.reopens);
+                c.frames_dropped, c.bytes_written, c.write_would_block, c.write_errors, c.reopens,
+                origins_sent_, texts_sent_, distance_m_);
   return line;
 }
 

@@ -10,8 +10,10 @@ void TelemetryStage::run() {
   Health& health = ctx_.health;
   const auto hb_period_ns = static_cast<TimeNs>(1e9 / ctx_.config.telemetry.heartbeat_hz);
   const auto deadline_ns = static_cast<TimeNs>(ctx_.config.realtime.deadline_ms * 1e6);
+  const auto pose_timeout_ns = static_cast<TimeNs>(ctx_.config.telemetry.pose_timeout_s * 1e9);
   TimeNs next_hb = runtime::monotonicNs();
-  bool pending = false;  // a pose whose last byte has not left yet
+  TimeNs last_pose_ns = next_hb;  // the start counts as a pose: the camera gets the timeout
+  bool pending = false;           // a pose whose last byte has not left yet
   std::uint64_t pending_seq = 0;
   TimeNs pending_trigger = 0;
   TimeNs drain_until = 0;  // after the estimator finished: flush for at most this long
@@ -34,6 +36,7 @@ void TelemetryStage::run() {
     PoseRecord pose;
     while (ch.poses.pop(&pose)) {
       const TimeNs now = runtime::monotonicNs();
+      last_pose_ns = now;
       ctx_.profiler.stamp(pose.sequence, runtime::Stamp::kPublishStart, now);
       if (pending) complete(link_ ? link_->lastByteWrittenNs() : now);  // superseded while pending
       pending = true;
@@ -51,6 +54,9 @@ void TelemetryStage::run() {
       next_log_flush = now + kLogFlushPeriodNs;
     }
     if (link_) {
+      // Stale: no pose for pose_timeout_s while the estimator still runs (HEARTBEAT CRITICAL).
+      const bool estimating = !ch.estimator_done.load(std::memory_order_acquire);
+      link_->setPoseStale(estimating && now - last_pose_ns > pose_timeout_ns, now);
       if (!link_->service(now).isOk()) health.link_errors.fetch_add(1, std::memory_order_relaxed);
       if (pending && link_->drained()) complete(link_->lastByteWrittenNs());
       if (now >= next_hb) {

@@ -1,11 +1,16 @@
 'use strict';
-// Shared by serialize.js and check_stream.js: the two messages sunvo sends, as node-mavlink
+// Shared by serialize.js and check_stream.js: the messages sunvo sends, as node-mavlink
 // classes, and the conversion between them and the JSON the C++ tests write.
 // JSON conventions: uint64 as a decimal string, NaN as the string "NaN", field names as
 // node-mavlink spells them (camelCase).
 const { minimal, common } = require('node-mavlink');
 
-const CLASSES = { 0: minimal.Heartbeat, 331: common.Odometry };
+const CLASSES = {
+  0: minimal.Heartbeat,
+  48: common.SetGpsGlobalOrigin,
+  253: common.StatusText,
+  331: common.Odometry,
+};
 
 function fromJsonNumber(v) {
   return v === 'NaN' ? NaN : v;

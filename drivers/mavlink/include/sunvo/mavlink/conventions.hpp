@@ -45,6 +45,16 @@ struct OdometryInput {
 
 enum class WorldConvention { kEnu, kCameraFirstFrame };
 
+// Which autopilot reads the stream; only the frame ids differ (docs/telemetry.md, "Autopilot
+// profiles", cites the receiving code of each):
+//   kPx4       frame_id as toOdometry sets it: MAV_FRAME_LOCAL_NED (1) for kEnu, LOCAL_FRD (20)
+//              for kCameraFirstFrame; child_frame_id MAV_FRAME_BODY_FRD (12).
+//   kArduPilot frame_id MAV_FRAME_LOCAL_FRD (20), child_frame_id MAV_FRAME_BODY_FRD (12): the only
+//              pair ArduPilot's ODOMETRY handler takes. For kEnu the numbers stay NED: a NED frame
+//              is an earth-fixed FRD frame whose forward axis is north.
+enum class FrameProfile { kPx4, kArduPilot };
+void applyProfile(FrameProfile profile, Odometry* odo);
+
 // Rotation from the estimator's world w to the sent frame l (see above).
 Eigen::Matrix3d worldToLocal(WorldConvention world, const Eigen::Matrix3d& C_b_c);
 

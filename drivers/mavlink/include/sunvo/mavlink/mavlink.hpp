@@ -1,6 +1,7 @@
 #pragma once
-// MAVLink v2 framing for the two messages sunvo sends: HEARTBEAT (#0) and ODOMETRY (#331, common
-// message set). Protocol only: no I/O, no allocation, no exceptions.
+// MAVLink v2 framing for the messages sunvo sends: HEARTBEAT (#0), ODOMETRY (#331),
+// SET_GPS_GLOBAL_ORIGIN (#48) and STATUSTEXT (#253) (common message set). Protocol only: no I/O, no
+// allocation, no exceptions.
 //
 // A v2 frame on the wire (all multi-byte numbers little-endian):
 //   [0] 0xFD  [1] payload length  [2] incompat flags  [3] compat flags  [4] seq  [5] sysid
@@ -10,7 +11,8 @@
 // XML order; trailing zero bytes are cut off (at least one payload byte stays), the receiver
 // fills them back in with zeros. Layouts and CRC_EXTRA were checked against node-mavlink 2.3.0
 // (mavlink-mappings: Heartbeat.MAGIC_NUMBER = 50, PAYLOAD_LENGTH = 9; Odometry.MAGIC_NUMBER = 91,
-// PAYLOAD_LENGTH = 233) and against the C headers generated from common.xml.
+// PAYLOAD_LENGTH = 233; SetGpsGlobalOrigin 41 / 21; StatusText 83 / 54) and against the C headers
+// generated from common.xml.
 
 #include <array>
 #include <cstddef>
@@ -33,6 +35,14 @@ inline constexpr std::size_t kPayloadBytesHeartbeat = 9;
 inline constexpr std::uint32_t kMsgIdOdometry = 331;
 inline constexpr std::uint8_t kCrcExtraOdometry = 91;
 inline constexpr std::size_t kPayloadBytesOdometry = 233;
+inline constexpr std::uint32_t kMsgIdSetGpsGlobalOrigin = 48;
+inline constexpr std::uint8_t kCrcExtraSetGpsGlobalOrigin = 41;
+inline constexpr std::size_t kPayloadBytesSetGpsGlobalOrigin = 21;
+inline constexpr std::uint32_t kMsgIdStatusText = 253;
+inline constexpr std::uint8_t kCrcExtraStatusText = 83;
+inline constexpr std::size_t kPayloadBytesStatusText = 54;
+inline constexpr std::size_t kStatusTextChars =
+    50;  // STATUSTEXT.text: char[50], NUL only if shorter
 
 // Enum values from common.xml / minimal.xml used by sunvo.
 inline constexpr std::uint8_t kMavFrameLocalNed = 1;    // MAV_FRAME_LOCAL_NED
@@ -40,6 +50,14 @@ inline constexpr std::uint8_t kMavFrameBodyFrd = 12;    // MAV_FRAME_BODY_FRD
 inline constexpr std::uint8_t kMavFrameLocalFrd = 20;   // MAV_FRAME_LOCAL_FRD
 inline constexpr std::uint8_t kMavEstimatorVision = 2;  // MAV_ESTIMATOR_TYPE_VISION
 inline constexpr std::uint8_t kMavlinkVersion = 3;      // HEARTBEAT.mavlink_version
+inline constexpr std::uint8_t kMavStateActive = 4;      // MAV_STATE_ACTIVE
+inline constexpr std::uint8_t kMavStateCritical = 5;    // MAV_STATE_CRITICAL
+// MAV_SEVERITY (STATUSTEXT.severity): lower is more severe.
+inline constexpr std::uint8_t kMavSeverityCritical = 2;
+inline constexpr std::uint8_t kMavSeverityError = 3;
+inline constexpr std::uint8_t kMavSeverityWarning = 4;
+inline constexpr std::uint8_t kMavSeverityNotice = 5;
+inline constexpr std::uint8_t kMavSeverityInfo = 6;
 
 struct Heartbeat {
   std::uint8_t type = 18;          // MAV_TYPE_ONBOARD_CONTROLLER
@@ -68,6 +86,26 @@ struct Odometry {
   std::int8_t quality = 0;  // %, -1 failed, 0 unknown, 1 worst .. 100 best
 };
 
+// SET_GPS_GLOBAL_ORIGIN (#48): the geodetic point the local frame (x = y = z = 0) sits at.
+// Payload: latitude 0, longitude 4, altitude 8 (int32), target_system 12 (uint8), then the
+// extension time_usec 13 (uint64).
+struct SetGpsGlobalOrigin {
+  std::int32_t latitude = 0;       // degE7 (WGS84)
+  std::int32_t longitude = 0;      // degE7 (WGS84)
+  std::int32_t altitude = 0;       // mm above mean sea level
+  std::uint8_t target_system = 0;  // 0 = every system
+  std::uint64_t time_usec = 0;     // us since the Unix epoch; 0 = unknown
+};
+
+// STATUSTEXT (#253): a line of text for the operator. Payload: severity 0, text 1..50, then the
+// extensions id 51 (uint16) and chunk_seq 53 (uint8).
+struct StatusText {
+  std::uint8_t severity = kMavSeverityInfo;   // MAV_SEVERITY
+  std::array<char, kStatusTextChars> text{};  // not NUL-terminated when all 50 are used
+  std::uint16_t id = 0;                       // 0: a single-chunk message
+  std::uint8_t chunk_seq = 0;
+};
+
 // Who sends: MAVLink system and component ids.
 struct Endpoint {
   std::uint8_t system_id = 1;
@@ -84,6 +122,12 @@ std::size_t encodeHeartbeat(const Heartbeat& msg, const Endpoint& from, std::uin
                             std::uint8_t* out);
 std::size_t encodeOdometry(const Odometry& msg, const Endpoint& from, std::uint8_t seq,
                            std::uint8_t* out);
+std::size_t encodeSetGpsGlobalOrigin(const SetGpsGlobalOrigin& msg, const Endpoint& from,
+                                     std::uint8_t seq, std::uint8_t* out);
+std::size_t encodeStatusText(const StatusText& msg, const Endpoint& from, std::uint8_t seq,
+                             std::uint8_t* out);
+// Copies text into msg->text (cut at 50 chars, the rest zero); no allocation.
+void setStatusText(const char* text, StatusText* msg);
 
 // One frame received with a good CRC. payload holds payload_length bytes as sent (truncated);
 // the rest of the array is zero, so decoders can read the full layout.
@@ -134,5 +178,7 @@ class Decoder {
 // Decode the payload of a frame; false when msgid does not match.
 bool decodeHeartbeat(const Frame& frame, Heartbeat* out);
 bool decodeOdometry(const Frame& frame, Odometry* out);
+bool decodeSetGpsGlobalOrigin(const Frame& frame, SetGpsGlobalOrigin* out);
+bool decodeStatusText(const Frame& frame, StatusText* out);
 
 }  // namespace sunvo::mavlink

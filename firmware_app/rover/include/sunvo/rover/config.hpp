@@ -19,6 +19,7 @@
 
 #include "sunvo/core/fields.hpp"
 #include "sunvo/core/status.hpp"
+#include "sunvo/mavlink/conventions.hpp"
 #include "sunvo/pipeline/sun_aided_odometry.hpp"
 #include "sunvo/runtime/frame_pool.hpp"
 #include "sunvo/runtime/rt_setup.hpp"
@@ -34,6 +35,13 @@ inline std::span<const std::string_view> enumNames(V4l2PixelFormat) {
   return kNames;
 }
 }  // namespace sunvo::v4l2
+
+namespace sunvo::mavlink {
+inline std::span<const std::string_view> enumNames(FrameProfile) {
+  static constexpr std::string_view kNames[] = {"px4", "ardupilot"};
+  return kNames;
+}
+}  // namespace sunvo::mavlink
 
 namespace sunvo::rover {
 
@@ -220,23 +228,39 @@ struct SerialConfig {
 };
 
 struct TelemetryConfig {
-  double heartbeat_hz = 1.0;        // Hz, (0, 50]
-  int system_id = 1;                // [1, 255]
-  int component_id = 197;           // [1, 255] (197 = MAV_COMP_ID_VISUAL_INERTIAL_ODOMETRY)
-  double position_sigma_m = 0.1;    // m, (0, 1000]: reported position std when tracking
-  double attitude_sigma_deg = 1.0;  // deg, (0, 180]: reported attitude std when tracking
-  int full_quality_inliers = 150;   // RANSAC inliers that count as quality 100, [1, 100000]
+  // Which autopilot reads ODOMETRY: px4 (frame_id MAV_FRAME_LOCAL_NED) or ardupilot
+  // (MAV_FRAME_LOCAL_FRD); child_frame_id is MAV_FRAME_BODY_FRD for both (docs/telemetry.md).
+  mavlink::FrameProfile frame = mavlink::FrameProfile::kPx4;
+  double heartbeat_hz = 1.0;  // Hz, (0, 50]
+  int system_id = 1;          // [1, 255]
+  int component_id = 197;     // [1, 255] (197 = MAV_COMP_ID_VISUAL_INERTIAL_ODOMETRY)
+  // Reported position std: position_sigma_m + position_sigma_per_m * (path length since start).
+  double position_sigma_m = 0.1;       // m, (0, 1000]: at the start
+  double position_sigma_per_m = 0.02;  // m per m travelled, [0, 1] (0.02 = 2 % of distance)
+  // deg, (0, 180]: reported attitude std when the estimator has no attitude covariance (sun
+  // fusion off); with the sun on, the sun filter's covariance is sent instead.
+  double attitude_sigma_deg = 1.0;
+  int full_quality_inliers = 150;  // RANSAC inliers that count as quality 100, [1, 100000]
+  double origin_period_s = 10.0;   // s, [0, 3600]: SET_GPS_GLOBAL_ORIGIN again after this (0 =
+                                   //   only at start)
+  double statustext_min_interval_s = 1.0;  // s, [0, 60]: at most one STATUSTEXT per interval
+  double pose_timeout_s = 1.0;             // s, (0, 60]: no pose for this long = a fault (CRITICAL)
   // TUM pose log of every published pose (pose_log.hpp), appended to; empty: none.
   std::string pose_log;
   int pose_log_buffer_kb = 64;  // KiB, [1, 65536]: the log's line buffer, written when full
   template <class Self, class V>
   static void fields(Self& s, V& v) {
+    v("frame", s.frame);
     v("heartbeat_hz", s.heartbeat_hz);
     v("system_id", s.system_id);
     v("component_id", s.component_id);
     v("position_sigma_m", s.position_sigma_m);
+    v("position_sigma_per_m", s.position_sigma_per_m);
     v("attitude_sigma_deg", s.attitude_sigma_deg);
     v("full_quality_inliers", s.full_quality_inliers);
+    v("origin_period_s", s.origin_period_s);
+    v("statustext_min_interval_s", s.statustext_min_interval_s);
+    v("pose_timeout_s", s.pose_timeout_s);
     v("pose_log", s.pose_log);
     v("pose_log_buffer_kb", s.pose_log_buffer_kb);
   }

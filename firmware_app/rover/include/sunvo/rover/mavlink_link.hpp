@@ -1,11 +1,20 @@
 #pragma once
-// PoseLink over a serial port with MAVLink v2: ODOMETRY (#331) per pose, HEARTBEAT (#0) on
-// request (drivers/mavlink for the framing and the frame conventions, drivers/serial for the
-// non-blocking port). The world is ENU at the first GPS fix (MAV_FRAME_LOCAL_NED on the wire),
-// the body is the camera looking forward (MAV_FRAME_BODY_FRD). Covariance: the configured
-// position and attitude sigmas while tracking, x10 after a recovery, unknown while lost.
-// Quality: 100 * RANSAC inliers / full_quality_inliers (capped at 100) while tracking, half of
-// that on a recovered frame, -1 while lost.
+// PoseLink over a serial port with MAVLink v2 (drivers/mavlink for the framing and the frame
+// conventions, drivers/serial for the non-blocking port). Sends:
+//   ODOMETRY (#331) per pose. The world is ENU at the first GPS fix, sent as NED numbers; the
+//     body is the camera looking forward (MAV_FRAME_BODY_FRD). frame_id by telemetry.frame:
+//     px4 -> MAV_FRAME_LOCAL_NED, ardupilot -> MAV_FRAME_LOCAL_FRD. Covariance: attitude from the
+//     sun filter (world frame, rotated into the sent frame by toOdometry) or the configured sigma
+//     without the sun; position sigma = position_sigma_m + position_sigma_per_m * path length
+//     since start (summed over tracked frames). Unknown (NaN) while lost. Quality: 100 * RANSAC
+//     inliers / full_quality_inliers (capped at 100) while tracking, half of that on a recovered
+//     frame, -1 while lost.
+//   SET_GPS_GLOBAL_ORIGIN (#48) once the app has set the world origin (world.init config: world.*;
+//     oxts: the drive's first fix), then every telemetry.origin_period_s. The port is write-only
+//     here, so requests are not read: the periodic resend answers them.
+//   HEARTBEAT (#0): system_status ACTIVE, CRITICAL while tracking is lost or poses are stale.
+//   STATUSTEXT (#253) on fault transitions (lost, recovered, stale, resumed), at most one per
+//     statustext_min_interval_s; a newer text replaces a waiting one. No allocation.
 
 #include <array>
 #include <memory>
@@ -20,7 +29,12 @@
 namespace sunvo::rover {
 
 // The ODOMETRY input of a pose (also used by tests and the HIL reader's checks).
-mavlink::OdometryInput odometryInput(const PoseRecord& pose, const TelemetryConfig& telemetry);
+// distance_m: path length since start, m (position sigma grows with it).
+mavlink::OdometryInput odometryInput(const PoseRecord& pose, const TelemetryConfig& telemetry,
+                                     double distance_m);
+
+// The SET_GPS_GLOBAL_ORIGIN of a world origin (deg, deg, m above MSL); time_usec 0 (unknown).
+mavlink::SetGpsGlobalOrigin globalOrigin(double lat_deg, double lon_deg, double alt_m);
 
 class MavlinkSerialLink final : public PoseLink {
  public:
@@ -31,16 +45,38 @@ class MavlinkSerialLink final : public PoseLink {
   Status service(TimeNs now_mono_ns) override;
   bool drained() const override { return port_->queuedBytes() == 0; }
   TimeNs lastByteWrittenNs() const override { return port_->lastByteWrittenNs(); }
+  void setPoseStale(bool stale, TimeNs now_mono_ns) override;
+  void setWorldOrigin(double lat_deg, double lon_deg, double alt_m) override;
   std::string countersText() const override;
+  double distanceM() const { return distance_m_; }
 
  private:
   MavlinkSerialLink(std::unique_ptr<serial::SerialPort> port, const TelemetryConfig& telemetry);
+  Status sendOrigin(TimeNs now_mono_ns);
+  // Queues a STATUSTEXT (replacing one that waits) and sends it when the rate limit allows.
+  void queueText(std::uint8_t severity, const char* text);
+  Status sendPendingText(TimeNs now_mono_ns);
 
   std::unique_ptr<serial::SerialPort> port_;
   TelemetryConfig telemetry_;
   mavlink::Endpoint endpoint_;
   Eigen::Matrix3d C_b_c_;
+  mavlink::SetGpsGlobalOrigin origin_;
+  bool have_origin_ = false;
   std::uint8_t seq_ = 0;
+  // Path length over tracked frames, m, and the last tracked position.
+  double distance_m_ = 0.0;
+  bool have_last_p_ = false;
+  Eigen::Vector3d last_p_w_ = Eigen::Vector3d::Zero();
+  bool lost_ = false;   // the last pose was kLost
+  bool stale_ = false;  // setPoseStale(true) last
+  TimeNs next_origin_ns_ = 0;
+  mavlink::StatusText pending_text_;
+  bool text_pending_ = false;
+  bool text_sent_once_ = false;
+  TimeNs last_text_ns_ = 0;
+  std::uint64_t texts_sent_ = 0;
+  std::uint64_t origins_sent_ = 0;
   std::array<std::uint8_t, mavlink::kMaxFrameBytes> buffer_{};
 };
 

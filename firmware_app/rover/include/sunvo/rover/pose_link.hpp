@@ -24,6 +24,10 @@ struct PoseRecord {
   int tracking = 0;                // vo::TrackingStatus as int
   int ransac_inliers = 0;
   std::uint8_t reset_counter = 0;  // incremented at each tracking recovery
+  // Attitude covariance of the world attitude (rad^2, world-frame perturbation, the estimator's
+  // sun filter), upper triangle xx xy xz yy yz zz; valid only with the sun fusion on.
+  double cov_theta_w[6] = {0, 0, 0, 0, 0, 0};
+  bool cov_theta_valid = false;
 };
 
 class PoseLink {
@@ -38,6 +42,19 @@ class PoseLink {
   virtual bool drained() const = 0;
   // Monotonic ns when the last byte of the last complete frame was written (0 = none yet).
   virtual TimeNs lastByteWrittenNs() const = 0;
+  // The telemetry thread's view of the pose stream: stale = no pose for telemetry.pose_timeout_s
+  // while the estimator runs. A MAVLink link reports it (HEARTBEAT, STATUSTEXT); default: ignored.
+  virtual void setPoseStale(bool stale, TimeNs now_mono_ns) {
+    (void)stale;
+    (void)now_mono_ns;
+  }
+  // The geodetic origin of the world frame (deg, deg, m above MSL), set once before the stream
+  // starts; a MAVLink link announces it (SET_GPS_GLOBAL_ORIGIN); default: ignored.
+  virtual void setWorldOrigin(double lat_deg, double lon_deg, double alt_m) {
+    (void)lat_deg;
+    (void)lon_deg;
+    (void)alt_m;
+  }
   // One line of counters for the summary.
   virtual std::string countersText() const = 0;
 };
