@@ -131,6 +131,12 @@ TEST(RoverConfig, ErrorsNameTheFileTheKeyAndTheLine) {
             std::string::npos)
       << budget.status().message();
 
+  auto bad_frames = loadRoverConfig(path, {{"source.max_consecutive_bad_frames", "0"}});
+  ASSERT_FALSE(bad_frames);
+  EXPECT_NE(bad_frames.status().message().find("source.max_consecutive_bad_frames: 0 is outside"),
+            std::string::npos)
+      << bad_frames.status().message();
+
   auto q = loadRoverConfig(path, {{"queues.frames", "3"}});
   ASSERT_FALSE(q);
   EXPECT_NE(q.status().message().find("queues.frames: 3 is not a power of two"), std::string::npos);

@@ -70,6 +70,9 @@ struct DatasetOptions {
   std::int64_t first_frame = 0;  // index, >= 0: first frame of the range
   std::int64_t last_frame = -1;  // index, >= first_frame; -1 = the last frame
   bool color = false;            // the image source also delivers the colour pair (2/3)
+  // Images: a missing image file is not an error at open, and imageSourceOptions() drops bad
+  // frames (kitti::KittiSourceOptions::drop_bad_frames); false = every image must be there.
+  bool drop_bad_frames = false;
 
   Status validate() const;
 };
