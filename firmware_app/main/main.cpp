@@ -138,7 +138,10 @@ int main(int argc, char** argv) {
       rss_warm_frame = (*app)->framesProcessed();
       rss_warm_kb = residentKb();
     }
-    if ((*app)->finished()) break;
+    if ((*app)->finished()) {
+      if ((*app)->sourceFailed()) reason = "the frame source failed persistently";
+      break;
+    }
   }
   (*app)->requestStop();
   (*app)->join();
@@ -162,5 +165,5 @@ int main(int argc, char** argv) {
                 config->profiling.output_dir.c_str());
   }
   std::fflush(stdout);
-  return 0;
+  return (*app)->sourceFailed() ? 1 : 0;
 }

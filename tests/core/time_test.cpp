@@ -36,6 +36,25 @@ TEST(Time, RejectsMalformedText) {
   }
 }
 
+// Found by fuzzing (tests/fuzz/fuzz_kitti_timestamps): a year beyond int64 ns overflowed
+// (signed overflow, undefined) instead of being an error.
+TEST(Time, YearsBeyondInt64NanosecondsAreRejected) {
+  for (const char* far : {"2411-09-26 13:02:25.9677448", "1677-01-01 00:00:00",
+                          "-999-01-01 00:00:00", "9999-12-31 23:59:59"}) {
+    auto t = parseCivilTime(far, 0);
+    ASSERT_FALSE(t) << far;
+    EXPECT_NE(t.status().message().find("year out of range"), std::string::npos)
+        << t.status().message();
+  }
+  // The ends of the accepted range, with the largest UTC offsets.
+  auto first = parseCivilTime("1678-01-01 00:00:00", 50400);
+  ASSERT_TRUE(first);
+  EXPECT_EQ(*first, civilToUtcNs(1678, 1, 1, 0, 0, 0, 0) - 50400 * kNsPerSecond);
+  auto last = parseCivilTime("2261-12-31 23:59:60.999999999", -50400);
+  ASSERT_TRUE(last);
+  EXPECT_GT(*last, civilToUtcNs(2261, 12, 31, 0, 0, 0, 0));
+}
+
 TEST(Time, FormatRoundTrip) {
   const TimeNs t = civilToUtcNs(2026, 11, 21, 23, 59, 59, 123456789);
   EXPECT_EQ(formatUtcIso(t), "2026-11-21T23:59:59.123456789Z");

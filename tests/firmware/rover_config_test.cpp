@@ -92,6 +92,21 @@ TEST(RoverConfig, DefaultsAndOverrides) {
   EXPECT_EQ(px4->telemetry.frame, mavlink::FrameProfile::kPx4);  // the default
 }
 
+// Found by fuzzing (tests/fuzz/fuzz_rover_yaml): a complex key ("? ...") made yaml-cpp throw out
+// of the reader, which ended the program; it is an error naming the file, line and section.
+TEST(RoverConfig, AComplexKeyIsAnErrorNotAnException) {
+  const std::string top =
+      writeConfig("complex_key.yaml", std::string(kMinimal) + "?  heap_reserve=mb: 64\n");
+  auto t = loadRoverConfig(top);
+  ASSERT_FALSE(t);
+  EXPECT_EQ(t.status().message(), top + ":7: top level: a key must be a plain name");
+  const std::string nested =
+      writeConfig("complex_nested_key.yaml", std::string(kMinimal) + "  ? [a, b]\n  : 3\n");
+  auto n = loadRoverConfig(nested);
+  ASSERT_FALSE(n);
+  EXPECT_EQ(n.status().message(), nested + ":7: estimator: a key must be a plain name");
+}
+
 TEST(RoverConfig, ErrorsNameTheFileTheKeyAndTheLine) {
   const std::string path = writeConfig("minimal.yaml", kMinimal);
   auto range = loadRoverConfig(path, {{"estimator.window.max_num_iterations", "0"}});
@@ -150,6 +165,12 @@ TEST(RoverConfig, ErrorsNameTheFileTheKeyAndTheLine) {
   EXPECT_NE(budget.status().message().find("realtime.min_solver_time_ms: 50 is outside [0.1, 40]"),
             std::string::npos)
       << budget.status().message();
+
+  auto bad_frames = loadRoverConfig(path, {{"source.max_consecutive_bad_frames", "0"}});
+  ASSERT_FALSE(bad_frames);
+  EXPECT_NE(bad_frames.status().message().find("source.max_consecutive_bad_frames: 0 is outside"),
+            std::string::npos)
+      << bad_frames.status().message();
 
   auto q = loadRoverConfig(path, {{"queues.frames", "3"}});
   ASSERT_FALSE(q);

@@ -11,13 +11,13 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
-#include <mutex>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 #include <regex>
 #include <thread>
 #include <vector>
 
+#include "../support/recording_link.hpp"
 #include "sunvo/emulated/emulated_gpio.hpp"
 #include "sunvo/emulated/emulated_v4l2.hpp"
 #include "sunvo/files/trajectory_io.hpp"
@@ -34,30 +34,7 @@ constexpr TimeNs kExposureDelay = 3'000'000;  // strobe edge -> V4L2 buffer time
 constexpr double kRateHz = 20.0;
 constexpr int kStrobeLine = 17;
 
-// Records every pose the telemetry thread hands over (the port is not under test here).
-class RecordingLink final : public PoseLink {
- public:
-  Status sendPose(const PoseRecord& pose, TimeNs now) override {
-    std::lock_guard<std::mutex> lock(mutex_);
-    poses_.push_back(pose);
-    last_ns_ = now;
-    return Status::ok();
-  }
-  Status sendHeartbeat(TimeNs) override { return Status::ok(); }
-  Status service(TimeNs) override { return Status::ok(); }
-  bool drained() const override { return true; }
-  TimeNs lastByteWrittenNs() const override { return last_ns_; }
-  std::string countersText() const override { return "recording link"; }
-  std::vector<PoseRecord> poses() const {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return poses_;
-  }
-
- private:
-  mutable std::mutex mutex_;
-  std::vector<PoseRecord> poses_;
-  TimeNs last_ns_ = 0;
-};
+using sunvo::testing::RecordingLink;
 
 // A textured plane 12 px of disparity away, sliding 2 px per frame: trackable stereo images.
 emulated::FrameContent planeContent(const cv::Mat& texture, int disparity) {

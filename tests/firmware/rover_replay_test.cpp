@@ -8,15 +8,26 @@
 #include <sys/file.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <regex>
 #include <sstream>
+#include <thread>
 
+#include "../support/recording_link.hpp"
+#include "../support/temp_dir.hpp"
 #include "sunvo/metrics/metrics.hpp"
 #include "sunvo/render/drive.hpp"
 #include "sunvo/replay/replay.hpp"
+#include "sunvo/rover/app.hpp"
+#include "sunvo/rover/config.hpp"
+#include "sunvo/runtime/clock.hpp"
 
 namespace sunvo {
 namespace {
@@ -180,6 +191,152 @@ TEST(RoverReplay, SunCnnProviderEveryFifthFrame) {
   const std::regex results("queue sun_results +cap [0-9]+: pushed ([0-9]+)");
   ASSERT_TRUE(std::regex_search(run.log, m, results)) << run.log;
   EXPECT_EQ(std::atoi(m[1].str().c_str()), expected_calls);  // every call answered
+}
+
+// A copy of the rendered drive's gray images, OXTS and calibration (no colour pair) with injected
+// image faults: frame 3's left image missing, frame 4's right image truncated, frame 9's left
+// image of the wrong size and frame 14's right image with three channels.
+struct FaultyDrive {
+  sunvo::testing::TempDir dir;
+  std::string drive;
+  std::vector<std::uint64_t> bad{3, 4, 9, 14};
+};
+
+void makeFaultyDrive(const std::string& rendered, FaultyDrive* out) {
+  const fs::path src(rendered);
+  const fs::path day = fs::path(out->dir.str()) / src.parent_path().filename();
+  const fs::path drive = day / src.filename();
+  fs::create_directories(drive);
+  for (const auto& f : fs::directory_iterator(src.parent_path())) {
+    if (f.is_regular_file()) fs::copy_file(f.path(), day / f.path().filename());
+  }
+  for (const char* sub : {"image_00", "image_01", "oxts"}) {
+    fs::copy(src / sub, drive / sub, fs::copy_options::recursive);
+  }
+  out->drive = drive.string();
+  const auto image = [&](int camera, int frame) {
+    char name[64];
+    std::snprintf(name, sizeof(name), "image_%02d/data/%010d.png", camera, frame);
+    return (drive / name).string();
+  };
+  fs::remove(image(0, 3));
+  fs::resize_file(image(1, 4), fs::file_size(image(1, 4)) / 3);
+  ASSERT_TRUE(cv::imwrite(image(0, 9), cv::Mat(100, 200, CV_8UC1, cv::Scalar(90))));
+  ASSERT_TRUE(cv::imwrite(image(1, 14), cv::Mat(375, 1242, CV_8UC3, cv::Scalar(90))));
+}
+
+struct InProcessRun {
+  std::vector<rover::PoseRecord> poses;
+  std::string summary;
+  bool source_failed = false;
+  bool finished = false;
+};
+
+// RoverApp in-process on config/rover_replay.yaml (pure VO, poses recorded, end: stop) until it
+// finishes on its own (bounded).
+InProcessRun runInProcess(const std::string& drive,
+                          std::vector<std::pair<std::string, std::string>> sets) {
+  InProcessRun run;
+  sets.insert(
+      sets.begin(),
+      {{"source.kitti.drive_dir", drive},
+       {"source.kitti.end", "stop"},
+       {"sun.provider", "none"},
+       {"serial.device", "\"\""},
+       {"rt.lock_memory", "false"},
+       {"rt.heap_reserve_mb", "0"},
+       {"rt.threads",
+        "{capture: {fifo_priority: 0, cpu: -1}, estimator: {fifo_priority: 0, cpu: -1}, "
+        "sun: {fifo_priority: 0, cpu: -1}, telemetry: {fifo_priority: 0, cpu: -1}}"},
+       {"realtime.warmup_frames", "0"},
+       {"realtime.deadline_ms", "1000"},
+       {"profiling.output_dir", std::string(SUNVO_BINARY_DIR) + "/test_out/rover_bad_frames"}});
+  auto config =
+      rover::loadRoverConfig(std::string(SUNVO_SOURCE_DIR) + "/config/rover_replay.yaml", sets);
+  EXPECT_TRUE(config.hasValue()) << config.status().toString();
+  if (!config) return run;
+  auto link = std::make_unique<sunvo::testing::RecordingLink>();
+  sunvo::testing::RecordingLink* recorder = link.get();
+  auto app = rover::RoverApp::create(*config, std::move(link), rover::productionDevices());
+  EXPECT_TRUE(app.hasValue()) << app.status().toString();
+  if (!app) return run;
+  (*app)->start();
+  const TimeNs give_up = runtime::monotonicNs() + 60'000'000'000;
+  while (!(*app)->finished() && runtime::monotonicNs() < give_up) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  run.finished = (*app)->finished();
+  run.source_failed = (*app)->sourceFailed();
+  (*app)->requestStop();
+  (*app)->join();
+  run.poses = recorder->poses();
+  run.summary = (*app)->summary();
+  std::printf("%s", run.summary.c_str());
+  return run;
+}
+
+std::uint64_t summaryCount(const std::string& summary, const std::string& pattern) {
+  std::smatch m;
+  if (!std::regex_search(summary, m, std::regex(pattern))) {
+    ADD_FAILURE() << "no '" << pattern << "' in " << summary;
+    return 0;
+  }
+  return std::strtoull(m[1].str().c_str(), nullptr, 10);
+}
+
+// Bad images in the replay drive: each frame is dropped and counted as a grab error, VO goes on
+// from the last good frame, with and without preload; a fault that persists past
+// source.max_consecutive_bad_frames stops capture and marks the run failed.
+TEST(RoverReplay, BadImagesAreDroppedCountedAndAPersistentFaultStops) {
+  int frames = 0;
+  const std::string rendered = findOrRenderDrive(&frames);
+  ASSERT_FALSE(rendered.empty()) << "no rendered drive";
+  frames = 20;  // the first 20 frames are enough
+  FaultyDrive faulty;
+  makeFaultyDrive(rendered, &faulty);
+  if (HasFatalFailure()) return;
+  replay::ReplayOptions ro;
+  ro.dataset.path = rendered;
+  ro.dataset.last_frame = frames - 1;
+  auto truth = replay::openReplayDataset(ro);
+  ASSERT_TRUE(truth) << truth.status().toString();
+
+  for (const char* preload : {"true", "false"}) {
+    SCOPED_TRACE(std::string("preload ") + preload);
+    const InProcessRun run =
+        runInProcess(faulty.drive, {{"source.kitti.preload", preload},
+                                    {"source.kitti.last_frame", std::to_string(frames - 1)}});
+    EXPECT_TRUE(run.finished);
+    EXPECT_FALSE(run.source_failed);
+    EXPECT_EQ(summaryCount(run.summary, "grab errors ([0-9]+)"), faulty.bad.size());
+    EXPECT_EQ(summaryCount(run.summary, "grab errors in a row: at most ([0-9]+)"), 2u);
+    ASSERT_EQ(run.poses.size(), static_cast<std::size_t>(frames) - faulty.bad.size());
+    std::vector<std::uint64_t> expected;
+    for (std::uint64_t k = 0; k < static_cast<std::uint64_t>(frames); ++k) {
+      if (std::find(faulty.bad.begin(), faulty.bad.end(), k) == faulty.bad.end()) {
+        expected.push_back(k);
+      }
+    }
+    std::vector<std::uint64_t> got;
+    for (const rover::PoseRecord& p : run.poses) got.push_back(p.sequence);
+    EXPECT_EQ(got, expected);
+    // VO went on from the last good frame: the final position is still close to the truth.
+    const rover::PoseRecord& last = run.poses.back();
+    const Eigen::Vector3d p_w(last.p_w[0], last.p_w[1], last.p_w[2]);
+    const double error_m = (p_w - truth->groundTruth()[last.sequence].translation()).norm();
+    std::printf("final position error with %zu dropped frames: %.4f m\n", faulty.bad.size(),
+                error_m);
+    EXPECT_LT(error_m, 0.2);
+  }
+  // Frames 3 and 4 are bad in a row: a limit of 1 stops capture at frame 4.
+  const InProcessRun stopped =
+      runInProcess(faulty.drive, {{"source.max_consecutive_bad_frames", "1"},
+                                  {"source.kitti.last_frame", std::to_string(frames - 1)},
+                                  {"source.kitti.end", "hold"}});
+  EXPECT_TRUE(stopped.finished);  // even with end: hold
+  EXPECT_TRUE(stopped.source_failed);
+  EXPECT_EQ(stopped.poses.size(), 3u);  // frames 0, 1, 2
+  EXPECT_NE(stopped.summary.find("capture stopped, the source fault persisted"), std::string::npos);
 }
 
 }  // namespace

@@ -255,6 +255,61 @@ TEST(KittiStereoSource, MissingImageIsAnErrorNamingFileAndFrame) {
   EXPECT_EQ(frame.sequence, 1u);
 }
 
+// drop_bad_frames: each kind of bad image drops its frame, the source moves on and counts it.
+TEST(KittiStereoSource, DropBadFramesSkipsAndCountsEachBadImage) {
+  RawDrive drive(7);
+  fs::remove(drive.imagePath(0, 1));      // missing
+  fs::resize_file(drive.imagePath(1, 2),  // truncated PNG
+                  fs::file_size(drive.imagePath(1, 2)) / 2);
+  drive.writeImage(0, 3, cv::Size(640, 480), 1);                // wrong size
+  drive.writeImage(1, 4, cv::Size(1242, 375), 3);               // wrong channel count
+  ASSERT_FALSE(KittiStereoSource::open(drive.options(false)));  // default: every file needed
+  KittiSourceOptions o = drive.options(false);
+  o.drop_bad_frames = true;
+  auto src = KittiStereoSource::open(o);
+  ASSERT_TRUE(src) << src.status().toString();
+  StereoFrame frame;
+  ASSERT_TRUE(src->next(frame));
+  EXPECT_EQ(frame.sequence, 0u);
+  for (int k = 1; k <= 4; ++k) {
+    const Status s = src->next(frame);
+    ASSERT_FALSE(s) << k;
+    EXPECT_NE(s.message().find("frame " + std::to_string(k) + ": "), std::string::npos)
+        << s.message();
+    EXPECT_FALSE(src->finished());
+    EXPECT_EQ(src->droppedFrames(), k);
+  }
+  for (std::uint64_t k = 5; k <= 6; ++k) {
+    ASSERT_TRUE(src->next(frame)) << k;
+    EXPECT_EQ(frame.sequence, k);
+    EXPECT_EQ(frame.trigger_time_ns, drive.times()[k]);
+    EXPECT_EQ(frame.left.at<unsigned char>(1, 1), RawDrive::value(0, static_cast<int>(k)));
+  }
+  EXPECT_EQ(src->next(frame).message(), "end of sequence");
+  EXPECT_TRUE(src->finished());
+  EXPECT_EQ(src->droppedFrames(), 4);
+
+  // Preloaded: the dropped frames keep their place with empty images.
+  auto all = loadAllFrames(o);
+  ASSERT_TRUE(all) << all.status().toString();
+  ASSERT_EQ(all->frames.size(), 7u);
+  EXPECT_EQ(all->dropped, 4);
+  for (std::size_t k = 0; k < 7; ++k) {
+    EXPECT_EQ(all->frames[k].sequence, k);
+    EXPECT_EQ(all->frames[k].trigger_time_ns, drive.times()[k]);
+    EXPECT_EQ(all->frames[k].left.empty(), k >= 1 && k <= 4) << k;
+  }
+  // Still no more images than timestamps.
+  drive.writeImage(0, 7, cv::Size(1242, 375), 1);  // 7 files again (frame 1 is missing)
+  ASSERT_TRUE(KittiStereoSource::open(o));
+  drive.writeImage(0, 8, cv::Size(1242, 375), 1);
+  src = KittiStereoSource::open(o);
+  ASSERT_FALSE(src);
+  EXPECT_NE(src.status().message().find("holds 8 PNG images but the timestamps list 7"),
+            std::string::npos)
+      << src.status().message();
+}
+
 TEST(KittiStereoSource, TimestampCountMismatchAndExtraImages) {
   RawDrive drive(4);
   const std::string ts1 = drive.drive() + "/image_01/timestamps.txt";

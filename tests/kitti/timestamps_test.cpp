@@ -62,6 +62,14 @@ TEST(KittiTimestamps, ErrorsNameFileLineAndField) {
   ASSERT_TRUE(t);
   EXPECT_EQ(t->size(), 2u);
 
+  // Found by fuzzing: a year beyond int64 ns is an error naming the line, not an overflow.
+  testing::writeText(path, "2011-09-26 13:02:25.1\n2411-09-26 13:02:25.9677448\n");
+  t = readRawTimestamps(path, 0);
+  ASSERT_FALSE(t);
+  EXPECT_EQ(t.status().message().rfind(path + ":2: field 'timestamp': ", 0), 0u)
+      << t.status().message();
+  EXPECT_NE(t.status().message().find("year out of range"), std::string::npos);
+
   testing::writeText(path, "0.0\n0.1 0.2\n");
   t = readOdometryTimes(path, 1);
   ASSERT_FALSE(t);

@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <filesystem>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include "sunvo/metrics/metrics.hpp"
 #include "sunvo/render/drive.hpp"
@@ -114,6 +117,55 @@ TEST(Replay, RenderedDriveThroughTheWholeChain) {
   auto raw_true = replayDrive(*raw_sun, raw_options, sources[0]);
   ASSERT_TRUE(raw_true) << raw_true.status().toString();
   EXPECT_EQ(raw_true->gate.accepted, 3u);
+
+  // Injected image faults: each bad frame is dropped and counted, VO matches the next good frame
+  // against the last good one and goes on; the run stops only past the configured limit.
+  const auto image = [&](int camera, int frame) {
+    char name[64];
+    std::snprintf(name, sizeof(name), "image_%02d/data/%010d.png", camera, frame);
+    return (raw_drive / name).string();
+  };
+  std::filesystem::remove(image(0, 7));  // missing
+  std::filesystem::resize_file(image(1, 8), std::filesystem::file_size(image(1, 8)) / 3);
+  ASSERT_TRUE(cv::imwrite(image(0, 12), cv::Mat(100, 200, CV_8UC1, cv::Scalar(90))));   // size
+  ASSERT_TRUE(cv::imwrite(image(1, 13), cv::Mat(375, 1242, CV_8UC3, cv::Scalar(90))));  // chans
+  auto faulty = openReplayDataset(raw_options);
+  ASSERT_TRUE(faulty) << faulty.status().toString();
+  auto dropped = replayDrive(*faulty, raw_options, std::nullopt);
+  ASSERT_TRUE(dropped) << dropped.status().toString();
+  EXPECT_EQ(dropped->dropped_frames, 4);
+  ASSERT_EQ(dropped->T_w_c.size(), 16u);
+  const std::vector<std::size_t> kept{0, 1, 2, 3, 4, 5, 6, 9, 10, 11, 14, 15, 16, 17, 18, 19};
+  EXPECT_EQ(dropped->frame_index, kept);
+  std::vector<Isometry3> gt_kept;
+  for (const std::size_t k : kept) gt_kept.push_back(faulty->groundTruth()[k]);
+  auto ev_dropped = metrics::evaluate(gt_kept, dropped->T_w_c, eval);
+  ASSERT_TRUE(ev_dropped) << ev_dropped.status().toString();
+  std::printf("replay with 4 bad frames dropped: drift %.4f m, rot ARMSE %.3g rad, %d lost\n",
+              ev_dropped->table1.final_drift_m, ev_dropped->table1.rot_armse_rad,
+              dropped->lost_frames);
+  EXPECT_LT(ev_dropped->table1.final_drift_m, 0.1);
+  EXPECT_LT(ev_dropped->table1.rot_armse_rad, 2e-3);
+  // The sun still comes on frames 5, 10, 15 (their own frame numbers).
+  auto dropped_sun = replayDrive(*faulty, raw_options, sources[0]);
+  ASSERT_TRUE(dropped_sun) << dropped_sun.status().toString();
+  EXPECT_EQ(dropped_sun->gate.total(), 3u);
+  // Frames 7 and 8 are two bad frames in a row: a limit of 1 stops the run at frame 8.
+  raw_options.max_consecutive_bad_frames = 1;
+  auto stopped = replayDrive(*faulty, raw_options, std::nullopt);
+  ASSERT_FALSE(stopped);
+  EXPECT_NE(stopped.status().message().find("frame 8"), std::string::npos)
+      << stopped.status().message();
+  EXPECT_NE(stopped.status().message().find("max_consecutive_bad_frames 1"), std::string::npos);
+  // 0: every image must be there, as before.
+  raw_options.max_consecutive_bad_frames = 0;
+  auto strict = openReplayDataset(raw_options);
+  ASSERT_FALSE(strict);
+  EXPECT_NE(strict.status().message().find("frame 7: image file missing"), std::string::npos)
+      << strict.status().message();
+  raw_options.max_consecutive_bad_frames = -1;
+  EXPECT_NE(raw_options.validate().message().find("replay.max_consecutive_bad_frames"),
+            std::string::npos);
   std::filesystem::remove_all(raw_day);
 }
 

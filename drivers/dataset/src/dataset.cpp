@@ -110,6 +110,7 @@ kitti::KittiSourceOptions Dataset::imageSourceOptions() const {
   o.first_frame = first_;
   o.last_frame = first_ + static_cast<std::int64_t>(times_ns_.size()) - 1;
   o.use_color = options_.color;
+  o.drop_bad_frames = options_.drop_bad_frames;
   if (kind_ == DatasetKind::kKittiOdometry) {
     o.layout = kitti::KittiLayout::kOdometry;
     o.odometry_start_time_ns = options_.odometry_start_utc_ns;

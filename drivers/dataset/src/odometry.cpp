@@ -71,6 +71,7 @@ Expected<Dataset> DatasetLoader::odometry(const DatasetOptions& options, const f
   so.layout = kitti::KittiLayout::kOdometry;
   so.odometry_start_time_ns = options.odometry_start_utc_ns;
   so.use_color = options.color;
+  so.drop_bad_frames = options.drop_bad_frames;
   auto source = kitti::KittiStereoSource::open(so);
   if (!source) return source.status();
   std::int64_t first = 0, last = 0;

@@ -82,6 +82,7 @@ Expected<Dataset> DatasetLoader::raw(const DatasetOptions& options, const fs::pa
   so.layout = kitti::KittiLayout::kRaw;
   so.utc_offset_s = offset;
   so.use_color = options.color;
+  so.drop_bad_frames = options.drop_bad_frames;
   auto source = kitti::KittiStereoSource::open(so);
   if (!source) return source.status();
   std::int64_t first = 0, last = 0;

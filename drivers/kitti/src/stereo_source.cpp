@@ -228,11 +228,14 @@ Status KittiStereoSource::checkImages(int camera) const {
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) return notFound("image folder missing: " + dir.string());
   // Every frame of the recording must have its image (not only the range): a gap would shift
-  // images against timestamps.
-  for (std::int64_t k = 0; k < frameCount(); ++k) {
-    const std::string path = imagePath(camera, k);
-    if (!fs::is_regular_file(path, ec)) {
-      return notFound(frameLabel(k) + ": image file missing: " + path);
+  // images against timestamps. With drop_bad_frames a missing file is a frame to drop, but there
+  // may still be no more images than timestamps.
+  if (!options_.drop_bad_frames) {
+    for (std::int64_t k = 0; k < frameCount(); ++k) {
+      const std::string path = imagePath(camera, k);
+      if (!fs::is_regular_file(path, ec)) {
+        return notFound(frameLabel(k) + ": image file missing: " + path);
+      }
     }
   }
   std::int64_t pngs = 0;
@@ -240,7 +243,7 @@ Status KittiStereoSource::checkImages(int camera) const {
     if (entry.path().extension() == ".png") ++pngs;
   }
   if (ec) return ioError("cannot list " + dir.string() + ": " + ec.message());
-  if (pngs != frameCount()) {
+  if (options_.drop_bad_frames ? pngs > frameCount() : pngs != frameCount()) {
     return parseError(dir.string() + " holds " + std::to_string(pngs) +
                       " PNG images but the "
                       "timestamps list " +
@@ -285,13 +288,7 @@ Status KittiStereoSource::readImage(int camera, std::int64_t index, int type, cv
   return Status::ok();
 }
 
-Status KittiStereoSource::next(StereoFrame& out) {
-  if (finished_) return endOfSequence();
-  if (next_index_ > last_) {
-    finished_ = true;
-    return endOfSequence();
-  }
-  const std::int64_t k = next_index_;
+Status KittiStereoSource::readFrame(std::int64_t k, StereoFrame& out) {
   SUNVO_RETURN_IF_ERROR(readImage(0, k, CV_8UC1, out.left));
   SUNVO_RETURN_IF_ERROR(readImage(1, k, CV_8UC1, out.right));
   if (options_.use_color) {
@@ -300,6 +297,23 @@ Status KittiStereoSource::next(StereoFrame& out) {
   } else {
     out.left_color.release();
     out.right_color.release();
+  }
+  return Status::ok();
+}
+
+Status KittiStereoSource::next(StereoFrame& out) {
+  if (finished_) return endOfSequence();
+  if (next_index_ > last_) {
+    finished_ = true;
+    return endOfSequence();
+  }
+  const std::int64_t k = next_index_;
+  if (const Status s = readFrame(k, out); !s.isOk()) {
+    if (options_.drop_bad_frames) {
+      ++next_index_;
+      ++dropped_frames_;
+    }
+    return s;
   }
   const TimeNs t = times_ns_[static_cast<std::size_t>(k)];
   out.trigger_time_ns = t;
@@ -324,11 +338,17 @@ Expected<LoadedFrames> loadAllFrames(const KittiSourceOptions& options) {
   if (!source) return source.status();
   LoadedFrames out;
   out.camera = source->camera();
-  while (true) {
+  for (std::int64_t k = options.first_frame; true; ++k) {
     StereoFrame frame;
     const Status s = source->next(frame);
     if (source->finished()) break;
-    SUNVO_RETURN_IF_ERROR(s);
+    if (!s.isOk()) {
+      if (!options.drop_bad_frames) return s;
+      frame = StereoFrame{};  // dropped: empty images, the index kept
+      frame.sequence = static_cast<std::uint64_t>(k);
+      frame.trigger_time_ns = source->frameTimes()[static_cast<std::size_t>(k)];
+      ++out.dropped;
+    }
     out.frames.push_back(std::move(frame));
   }
   return out;

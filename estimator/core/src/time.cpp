@@ -74,6 +74,9 @@ Expected<TimeNs> parseCivilTime(std::string_view text, std::int64_t utc_offset_s
     return bad("non-numeric field");
   }
   static constexpr std::array<int, 12> kDays{31, 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31};
+  // int64 ns since the epoch spans 1677-09-21 .. 2262-04-11; whole years inside it leave room
+  // for any UTC offset (found by fuzzing: year 2411 overflowed).
+  if (y < 1678 || y > 2261) return bad("year out of range [1678, 2261]");
   if (mo < 1 || mo > 12) return bad("month out of range");
   const int mdays = kDays[static_cast<std::size_t>(mo - 1)] + (mo == 2 && isLeap(y) ? 1 : 0);
   if (d < 1 || d > mdays) return bad("day out of range");

@@ -271,7 +271,7 @@ void RoverApp::requestStop() {
 bool RoverApp::finished() const {
   const Impl& s = *impl_;
   if (s.config.source.type == SourceType::kKitti && s.config.source.kitti.end == EndAction::kHold &&
-      !s.channels.stop.load()) {
+      !s.channels.stop.load() && !sourceFailed()) {
     return false;
   }
   return s.channels.telemetry_done.load(std::memory_order_acquire);
@@ -300,6 +300,10 @@ Expected<std::string> RoverApp::writeProfile(const std::string& tag) const {
   return text;
 }
 
+bool RoverApp::sourceFailed() const {
+  return impl_->health.source_fault_stop.load(std::memory_order_acquire);
+}
+
 std::uint64_t RoverApp::framesProcessed() const {
   return impl_->health.frames_processed.load(std::memory_order_relaxed);
 }
@@ -316,6 +320,9 @@ std::string RoverApp::summary() const {
           "), frames grabbed %" PRIu64 " (grab errors %" PRIu64 ", pool exhausted %" PRIu64 ")\n",
           g(h.triggers), g(h.trigger_timeouts), g(h.triggers_missed), g(h.triggers_duplicate),
           g(h.frames_grabbed), g(h.grab_errors), g(h.pool_exhausted));
+  appendf(&o, "  grab errors in a row: at most %" PRIu64 " (limit %d)%s\n",
+          g(h.grab_errors_in_a_row_max), s.config.source.max_consecutive_bad_frames,
+          h.source_fault_stop.load() ? ": capture stopped, the source fault persisted" : "");
   appendf(&o,
           "  frames processed %" PRIu64 ", estimator errors %" PRIu64 ", dropped at stop %" PRIu64
           ", late (age > 1 period) %" PRIu64 ", solver budget shrunk %" PRIu64 "\n",

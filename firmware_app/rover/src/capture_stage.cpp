@@ -9,6 +9,8 @@ void CaptureStage::run() {
   TriggerMonitor monitor(ctx_.period_ns);
   const auto timeout_ns =
       static_cast<TimeNs>(ctx_.config.trigger.timeout_factor * static_cast<double>(ctx_.period_ns));
+  const auto max_bad = static_cast<std::uint64_t>(ctx_.config.source.max_consecutive_bad_frames);
+  std::uint64_t bad_in_a_row = 0;
   while (!ch.stop.load(std::memory_order_acquire)) {
     TriggerEvent ev;
     const Status st = trigger_.wait(timeout_ns, &ev);
@@ -34,10 +36,20 @@ void CaptureStage::run() {
     runtime::FrameSlot& slot = ctx_.pool.slot(index);
     ctx_.profiler.begin(ev.sequence, ev.utc_ns, ev.mono_ns);
     if (!source_.grab(ev, slot).isOk()) {
+      // The frame is dropped; the estimator matches the next good frame against the last one.
       health.grab_errors.fetch_add(1, std::memory_order_relaxed);
       ctx_.pool.recycle(index);
+      ++bad_in_a_row;
+      if (bad_in_a_row > health.grab_errors_in_a_row_max.load(std::memory_order_relaxed)) {
+        health.grab_errors_in_a_row_max.store(bad_in_a_row, std::memory_order_relaxed);
+      }
+      if (bad_in_a_row > max_bad) {
+        health.source_fault_stop.store(true, std::memory_order_release);
+        break;
+      }
       continue;
     }
+    bad_in_a_row = 0;
     const TimeNs grabbed = runtime::monotonicNs();
     slot.meta.sequence = ev.sequence;
     slot.meta.trigger_mono_ns = ev.mono_ns;

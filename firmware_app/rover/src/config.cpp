@@ -104,6 +104,13 @@ class Reader {
   Status checkUnknown(const YAML::Node& node, const std::string& prefix) const {
     if (!node.IsMap()) return Status::ok();
     for (const auto& kv : node) {
+      // A complex key ("? [a, b]: 1") has no name to check (found by fuzzing: as<std::string>()
+      // threw out of the reader).
+      if (!kv.first.IsScalar()) {
+        return invalidArgument(file_ + ":" + line(kv.first) + ": " +
+                               (prefix.empty() ? std::string("top level") : prefix) +
+                               ": a key must be a plain name");
+      }
       const std::string key = join(prefix, kv.first.as<std::string>());
       if (sections_.count(key) != 0) {
         SUNVO_RETURN_IF_ERROR(checkUnknown(kv.second, key));  // a null section is empty
@@ -245,6 +252,8 @@ pipeline::SunAidedOptions roverEstimatorDefaults() {
 }
 
 Status RoverConfig::validate() const {
+  SUNVO_RETURN_IF_ERROR(checkRange("source.max_consecutive_bad_frames",
+                                   source.max_consecutive_bad_frames, 1, 1000000));
   const KittiSourceConfig& k = source.kitti;
   if (source.type == SourceType::kKitti) {
     if (k.drive_dir.empty()) return invalidArgument("source.kitti.drive_dir: empty");
@@ -401,10 +410,16 @@ Expected<RoverConfig> loadRoverConfig(
   RoverConfig config;
   config.path = path;
   Reader reader(path);
-  ReadVisitor visitor(reader, root, "");
-  RoverConfig::fields(config, visitor);
-  SUNVO_RETURN_IF_ERROR(visitor.status());
-  SUNVO_RETURN_IF_ERROR(reader.checkUnknown(root, ""));
+  // The reader checks node types before converting; a yaml-cpp exception that still escapes it
+  // is a bad file, never the end of the program.
+  try {
+    ReadVisitor visitor(reader, root, "");
+    RoverConfig::fields(config, visitor);
+    SUNVO_RETURN_IF_ERROR(visitor.status());
+    SUNVO_RETURN_IF_ERROR(reader.checkUnknown(root, ""));
+  } catch (const YAML::Exception& e) {
+    return parseError(path + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
+  }
   const Status s = config.validate();
   if (!s.isOk()) return Status(s.code(), path + ": " + s.message());
   return config;

@@ -50,7 +50,10 @@ struct Health {
   std::atomic<std::uint64_t> triggers_missed{0};
   std::atomic<std::uint64_t> triggers_duplicate{0};
   std::atomic<std::uint64_t> frames_grabbed{0};
-  std::atomic<std::uint64_t> grab_errors{0};
+  std::atomic<std::uint64_t> grab_errors{0};  // frames dropped: the source gave none or a bad one
+  std::atomic<std::uint64_t> grab_errors_in_a_row_max{0};
+  // Capture stopped: more than source.max_consecutive_bad_frames failed grabs in a row.
+  std::atomic<bool> source_fault_stop{false};
   std::atomic<std::uint64_t> pool_exhausted{0};
   std::atomic<std::uint64_t> frames_processed{0};
   std::atomic<std::uint64_t> frames_dropped_at_stop{0};

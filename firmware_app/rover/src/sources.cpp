@@ -90,11 +90,13 @@ Expected<std::unique_ptr<KittiReplaySource>> KittiReplaySource::open(
   d.utc_offset_s = config.utc_offset_s;
   d.first_frame = config.first_frame;
   d.last_frame = config.last_frame;
+  d.drop_bad_frames = true;  // a bad image drops its frame (grab() fails on it), never the run
   auto ds = dataset::Dataset::open(d);
   if (!ds) return ds.status();
   if (!ds->hasImages()) return invalidArgument(config.drive_dir + ": no images");
   kitti::KittiSourceOptions o = ds->imageSourceOptions();
   o.use_color = color;
+  o.drop_bad_frames = true;
   std::unique_ptr<KittiReplaySource> src(new KittiReplaySource());
   src->config_ = config;
   src->camera_ = ds->camera();
@@ -117,6 +119,10 @@ Status KittiReplaySource::grab(const TriggerEvent& trigger, runtime::FrameSlot& 
   StereoFrame& dst = slot.frame;
   if (!preloaded_.empty()) {
     const StereoFrame& src = preloaded_[static_cast<std::size_t>(index - config_.first_frame)];
+    if (src.left.empty()) {
+      return parseError("source.kitti: frame " + std::to_string(index) +
+                        ": bad image (dropped at preload)");
+    }
     if (src.left.size() != dst.left.size() || src.right.size() != dst.right.size()) {
       return invalidArgument("frames.width/height: " + std::to_string(dst.left.cols) + "x" +
                              std::to_string(dst.left.rows) + " differ from the drive's " +
@@ -128,6 +134,7 @@ Status KittiReplaySource::grab(const TriggerEvent& trigger, runtime::FrameSlot& 
       src.left_color.copyTo(dst.left_color);  // colour slots (image sun providers)
     }
   } else {
+    // A bad frame's error comes with the source moved past it (drop_bad_frames).
     SUNVO_RETURN_IF_ERROR(live_->next(dst));
   }
   dst.sequence = trigger.sequence;

@@ -70,6 +70,10 @@ int main(int argc, char** argv) {
   app.add_option("--image-max-drift-deg", options.image_max_drift_deg_per_frame,
                  "the same for the image estimators")
       ->check(CLI::Range(0.0, 5.0));
+  app.add_option("--max-bad-frames", options.max_consecutive_bad_frames,
+                 "bad frames (missing or corrupt image) dropped in a row before the run stops; "
+                 "0 = stop at the first")
+      ->check(CLI::Range(0, 100000));
   bool paper_form = false;
   app.add_flag("--paper-form", paper_form, "hold the base attitude fixed, as the paper did");
   app.add_option("--estimators", estimator_names,
@@ -127,17 +131,21 @@ int main(int argc, char** argv) {
                                                   (*estimators)[i - specs.size()].get())
                      : sunvo::replay::replayDrive(*data, options, specs[i]);
     if (!run) return sunvo::cli::fail(kProgram, run.status());
-    gt.assign(data->groundTruth().begin(),
-              data->groundTruth().begin() + static_cast<std::ptrdiff_t>(run->T_w_c.size()));
+    // The ground truth of the frames processed (dropped frames have no pose).
+    gt.clear();
+    for (const std::size_t k : run->frame_index) gt.push_back(data->groundTruth()[k]);
     sunvo::metrics::EvaluationOptions eval_opt;
     eval_opt.plane = input.plane;
     auto ev = sunvo::metrics::evaluate(gt, run->T_w_c, eval_opt);
     if (!ev) return sunvo::cli::fail(kProgram, ev.status());
     std::fprintf(stderr,
-                 "  %-28s %zu frames, %.1f ms/frame median, %.1f p99, %d lost, sun %llu/%llu\n",
+                 "  %-28s %zu frames, %.1f ms/frame median, %.1f p99, %d lost, %d dropped (bad "
+                 "image), sun %llu/%llu (%llu with the sun down)\n",
                  run->name.c_str(), run->T_w_c.size(), run->median_ms, run->p99_ms,
-                 run->lost_frames, static_cast<unsigned long long>(run->gate.accepted),
-                 static_cast<unsigned long long>(run->gate.total()));
+                 run->lost_frames, run->dropped_frames,
+                 static_cast<unsigned long long>(run->gate.accepted),
+                 static_cast<unsigned long long>(run->gate.total()),
+                 static_cast<unsigned long long>(run->gate.rejected_sun_down));
     if (run->sun_calls > 0) {
       std::fprintf(stderr, "  %-28s %d estimator calls, %.1f ms median, %.1f ms p90\n", "",
                    run->sun_calls, sunvo::metrics::percentile(run->sun_ms, 0.5),

@@ -12,6 +12,9 @@ Status ReplayOptions::validate() const {
   }
   SUNVO_RETURN_IF_ERROR(pipeline.validate());
   SUNVO_RETURN_IF_ERROR(fusion.validate());
+  if (max_consecutive_bad_frames < 0 || max_consecutive_bad_frames > 100000) {
+    return invalidArgument("replay.max_consecutive_bad_frames out of range [0, 100000]");
+  }
   // The cap's range is the fusion's own (min <= cap <= 5), checked by the fusion itself.
   if (const Status s = imageFusion().validate(); !s.isOk()) {
     return invalidArgument("replay.image_max_drift_deg_per_frame: " + s.message());
@@ -27,7 +30,9 @@ sunfusion::SunFusionOptions ReplayOptions::imageFusion() const {
 
 Expected<dataset::Dataset> openReplayDataset(const ReplayOptions& options) {
   SUNVO_RETURN_IF_ERROR(options.validate());
-  auto ds = dataset::Dataset::open(options.dataset);
+  dataset::DatasetOptions d = options.dataset;
+  d.drop_bad_frames = options.max_consecutive_bad_frames > 0;
+  auto ds = dataset::Dataset::open(d);
   if (!ds) return ds.status();
   if (!ds->hasImages()) {
     return invalidArgument(options.dataset.path + ": a " + dataset::toString(ds->kind()) +
@@ -57,6 +62,7 @@ Expected<ReplayRun> replayDrive(const dataset::Dataset& data, const ReplayOption
   // An image estimator looks at the colour image when the drive has one, else at the gray one.
   kitti::KittiSourceOptions src_opt = data.imageSourceOptions();
   src_opt.use_color = image_sun != nullptr && data.colorCamera().has_value();
+  src_opt.drop_bad_frames = options.max_consecutive_bad_frames > 0;
   if (image_sun != nullptr && !src_opt.use_color && !image_sun->acceptsGray()) {
     return notFound(data.folder() + ": " + image_sun->name() + " needs the colour images");
   }
@@ -85,10 +91,21 @@ Expected<ReplayRun> replayDrive(const dataset::Dataset& data, const ReplayOption
                                     : "Pure VO";
   StereoFrame frame;
   std::vector<double> ms;
+  int bad_in_a_row = 0;
+  // k: the frame's index in the dataset's range (a dropped frame advances it too).
   for (std::size_t k = 0; !source->finished(); ++k) {
     const Status s = source->next(frame);
     if (source->finished()) break;
-    SUNVO_RETURN_IF_ERROR(s);
+    if (!s.isOk()) {
+      if (++bad_in_a_row > options.max_consecutive_bad_frames) {
+        return Status(s.code(), s.message() + " (" + std::to_string(bad_in_a_row) +
+                                    " bad frames in a row, replay.max_consecutive_bad_frames " +
+                                    std::to_string(options.max_consecutive_bad_frames) + ")");
+      }
+      ++run.dropped_frames;
+      continue;
+    }
+    bad_in_a_row = 0;
     if (vo.isSunFrame(frame.sequence) && k < data.size()) {
       const Eigen::Vector3d sun_w =
           ephemeris ? data.ephemerisSunWorld()[k] : data.trueSun()[k].sun_w;
@@ -122,6 +139,7 @@ Expected<ReplayRun> replayDrive(const dataset::Dataset& data, const ReplayOption
     ms.push_back(r->times.total_ms);
     run.T_w_c.push_back(r->vo.T_w_c);
     run.times_ns.push_back(frame.trigger_time_ns);
+    run.frame_index.push_back(k);
   }
   run.gate = vo.sunCounters();
   run.median_ms = metrics::percentile(ms, 0.5);

@@ -76,6 +76,9 @@ struct DatasetOptions {
   int image_width = 0;
   int image_height = 0;
   double border_tolerance_px = 2.0;  // track folders: px, [0, 50]; see files/tracks_io.hpp
+  // Images: a missing image file is not an error at open, and imageSourceOptions() drops bad
+  // frames (kitti::KittiSourceOptions::drop_bad_frames); false = every image must be there.
+  bool drop_bad_frames = false;
 
   Status validate() const;
 };

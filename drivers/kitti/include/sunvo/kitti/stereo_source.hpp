@@ -13,8 +13,9 @@
 // cv::imdecode straight into the caller's StereoFrame Mats, so once the frame's Mats have the
 // right size and type no image memory is allocated per frame. A Mat whose buffer is shared with
 // another Mat header (refcount > 1) is released first, so a view the caller kept is never
-// overwritten. Errors never skip a frame: a missing or malformed image, disagreeing timestamp
-// counts, wrong size or channel count each give an error naming the file and frame number.
+// overwritten. By default errors never skip a frame: a missing or malformed image, disagreeing
+// timestamp counts, wrong size or channel count each give an error naming the file and frame
+// number. With drop_bad_frames a bad image drops its frame instead (see the option).
 
 #include <cstdint>
 #include <memory>
@@ -73,6 +74,13 @@ struct KittiSourceOptions {
   std::int64_t first_frame = 0;
   // Last frame index to deliver (inclusive), >= first_frame, < the number of frames; -1 = last.
   std::int64_t last_frame = -1;
+  // false: open() checks that every image file exists and a bad image fails next() on the same
+  // frame again and again (a recording is checked whole). true (a replay that must go on):
+  // open() accepts missing image files (not the odometry layout's first frame of the range,
+  // which gives the image size), and next() on a frame with a missing, truncated or corrupt
+  // image, or one of the wrong size or channel count, returns that error, moves past the frame
+  // and counts it in droppedFrames(); the next call delivers the next frame.
+  bool drop_bad_frames = false;
 
   // Checks the fields that do not need the files; the error names the bad key.
   Status validate() const;
@@ -89,8 +97,11 @@ class KittiStereoSource {
   // Fills `out` with the next frame (sequence = frame index in the recording). At the end of the
   // range returns kNotFound "end of sequence" and finished() becomes true; any other failure
   // leaves finished() false and does not advance (the same frame fails again).
+  // With drop_bad_frames a bad frame's error comes with the source moved past it.
   Status next(StereoFrame& out);
   bool finished() const { return finished_; }
+  // Frames dropped by next() for a bad image (drop_bad_frames only).
+  std::int64_t droppedFrames() const { return dropped_frames_; }
 
   KittiLayout layout() const { return layout_; }
   const StereoCamera& camera() const { return camera_; }  // rectified gray pair 0/1
@@ -112,6 +123,7 @@ class KittiStereoSource {
   Status openOdometry();
   Status checkImages(int camera) const;
   Status readImage(int camera, std::int64_t index, int type, cv::Mat& dst);
+  Status readFrame(std::int64_t index, StereoFrame& out);
 
   KittiSourceOptions options_;
   std::shared_ptr<PacingClock> clock_;
@@ -123,6 +135,7 @@ class KittiStereoSource {
   std::int64_t first_ = 0;
   std::int64_t last_ = 0;
   std::int64_t next_index_ = 0;
+  std::int64_t dropped_frames_ = 0;
   bool finished_ = false;
   bool pacing_started_ = false;
   TimeNs pacing_wall0_ns_ = 0;
@@ -132,9 +145,12 @@ class KittiStereoSource {
 
 // Every frame of a recording decoded into memory, for tests and benchmarks (a few hundred frames
 // at most: 1241x376 gray pairs take about 0.9 MB each).
+// With options.drop_bad_frames a dropped frame stays in `frames` with empty images (so index k of
+// `frames` is still frame first_frame + k) and is counted in `dropped`.
 struct LoadedFrames {
   StereoCamera camera;              // rectified gray pair 0/1 with the image size
   std::vector<StereoFrame> frames;  // in order; sequence = frame index
+  std::int64_t dropped = 0;         // frames with empty images (drop_bad_frames)
 };
 Expected<LoadedFrames> loadAllFrames(const KittiSourceOptions& options);
 

@@ -24,7 +24,8 @@ TimeNs civilToUtcNs(int year, int month, int day, int hour, int minute, int seco
 
 // Parses "YYYY-MM-DD HH:MM:SS[.fffffffff]" (KITTI raw timestamps; 'T' also accepted between
 // date and time) as a local time that is utc_offset_s ahead of UTC, and returns UTC ns.
-// Example: a recording made in UTC+1 is read with utc_offset_s = 3600.
+// Example: a recording made in UTC+1 is read with utc_offset_s = 3600. Years outside
+// [1678, 2261] (beyond int64 ns) are a parse error.
 Expected<TimeNs> parseCivilTime(std::string_view text, std::int64_t utc_offset_s);
 
 // Formats UTC ns as "YYYY-MM-DDTHH:MM:SS.fffffffffZ".

@@ -67,7 +67,8 @@ class RoverApp {
   // Asks every thread to finish: capture stops, queued frames are dropped, queued poses are sent.
   void requestStop();
   // True once the telemetry thread has finished: after requestStop(), or when a replay with
-  // end: stop has published its last pose (never for end: hold before a stop).
+  // end: stop has published its last pose (never for end: hold before a stop), or when capture
+  // stopped on a persistent source fault (sourceFailed()).
   bool finished() const;
   // Waits for the threads (after requestStop() or finished()).
   void join();
@@ -75,6 +76,9 @@ class RoverApp {
   // Latency CSV, Chrome trace and stage summary into profiling.output_dir, named <tag>_*.
   // Returns the stage summary text. Safe while running (SIGUSR1).
   Expected<std::string> writeProfile(const std::string& tag) const;
+  // True when capture stopped because the frame source failed more than
+  // source.max_consecutive_bad_frames times in a row (the run then ends as a replay's end does).
+  bool sourceFailed() const;
   // Frames the estimator has processed so far (any thread).
   std::uint64_t framesProcessed() const;
 

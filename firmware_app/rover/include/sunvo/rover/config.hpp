@@ -112,11 +112,16 @@ struct SourceConfig {
   SourceType type = SourceType::kKitti;
   KittiSourceConfig kitti;
   V4l2SourceConfig v4l2;
+  // frames, [1, 1000000]: failed grabs in a row (a missing or corrupt replay image, a camera that
+  // gives no frame while it is reopened) after which capture stops and sunvo_rover exits 1; each
+  // failed grab before that drops its frame and counts in the summary's grab errors.
+  int max_consecutive_bad_frames = 100;
   template <class Self, class V>
   static void fields(Self& s, V& v) {
     v("type", s.type);
     v("kitti", s.kitti);
     v("v4l2", s.v4l2);
+    v("max_consecutive_bad_frames", s.max_consecutive_bad_frames);
   }
 };
 

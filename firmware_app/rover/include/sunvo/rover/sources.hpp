@@ -104,7 +104,9 @@ class SimulatedTrigger final : public TriggerSource {
 // (drivers/dataset), which also gives the world: the origin and the first camera pose from the
 // first OXTS record of the range. With preload every frame of the range is decoded at start-up
 // and grab() copies it into the slot (no decoding, no allocation per frame); without preload
-// grab() decodes the next files (stop/hold only; libpng allocates per frame).
+// grab() decodes the next files (stop/hold only; libpng allocates per frame). A frame with a
+// missing or bad image (truncated, corrupt, wrong size or channel count) fails grab() for that
+// frame only; the capture stage drops and counts it (source.max_consecutive_bad_frames).
 class KittiReplaySource final : public FrameSource {
  public:
   // color: also deliver the left/right colour images (image_02/03) into slots that have them.

@@ -10,6 +10,9 @@
 // (experiment::SunSourceSpec), or an image estimator run on the left image every n-th frame with
 // the prior from the last VO pose. Ground truth for the evaluation: the dataset's.
 // Deterministic: the solver is bounded by iterations only.
+// Bad frames (a missing, truncated or corrupt image, or one of the wrong size or channel count) are
+// dropped and counted; VO matches the next good frame against the last good one. The run stops
+// with the frame's error only when more than max_consecutive_bad_frames come in a row.
 
 #include <optional>
 #include <string>
@@ -42,6 +45,9 @@ struct ReplayOptions {
   // the random walk's start value: on the three benchmark drives Sun-CNN made VO worse by up to
   // +246 % rot. ARMSE with 0.05, and by at most +0.5 % with 0.01 (docs/sun_estimators.md).
   double image_max_drift_deg_per_frame = 0.01;
+  // Bad frames in a row that are dropped before the run stops with the last one's error, frames,
+  // [0, 100000]; 0 = the first bad frame stops the run (and open() needs every image file).
+  int max_consecutive_bad_frames = 10;
   // The fusion options of an image-estimator run: `fusion` with the cap above.
   sunfusion::SunFusionOptions imageFusion() const;
   Status validate() const;
@@ -49,8 +55,10 @@ struct ReplayOptions {
 
 struct ReplayRun {
   std::string name;
-  std::vector<Isometry3> T_w_c;  // the dataset's world
-  std::vector<TimeNs> times_ns;  // the frames' times
+  std::vector<Isometry3> T_w_c;          // the dataset's world, one per frame processed
+  std::vector<TimeNs> times_ns;          // the frames' times
+  std::vector<std::size_t> frame_index;  // each pose's frame: index in the dataset's range
+  int dropped_frames = 0;                // bad frames dropped (see ReplayOptions)
   sunfusion::GateCounters gate;
   int lost_frames = 0;
   double median_ms = 0.0;  // pipeline time per frame
