@@ -1,0 +1,69 @@
+#!/usr/bin/env bash
+# The sanitizer job (run by .ci/run after scripts/test.sh):
+#  1. AddressSanitizer + UndefinedBehaviorSanitizer (preset sanitize) over the unit tests of the
+#     parsers, drivers and estimator (the areas in ASAN_AREAS: every file format, the V4L2/GPIO/
+#     serial drivers through their emulated devices, the front end, RANSAC, the Ceres window, VO,
+#     the sun fusion and the pipeline on real KITTI frames);
+#  2. ThreadSanitizer (preset tsan) over the rover's threads: the SPSC rings, the frame pool, the
+#     MAVLink link and the whole-program tests of sunvo_rover on emulated devices (capture,
+#     estimator, sun and telemetry threads).
+# The areas left out start other programs through the shell (their tests exercise the same
+# libraries) or render with POV-Ray (minutes per test under a sanitizer).
+#
+#   scripts/test_sanitize.sh [--asan-only | --tsan-only]
+#
+# Exit status: non-zero when a build fails or a sanitizer reports an error (the sanitizers abort
+# the test on the first report: -fno-sanitize-recover=all, halt_on_error=1).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+jobs=$(nproc)
+run_asan=1
+run_tsan=1
+case "${1:-}" in
+  --asan-only) run_tsan=0 ;;
+  --tsan-only) run_asan=0 ;;
+  "") ;;
+  *) echo "usage: $0 [--asan-only | --tsan-only]" >&2; exit 2 ;;
+esac
+
+ASAN_AREAS="core files kitti dataset geodesy metrics sun sunfusion mavlink serial sysio v4l2 gpio
+emulated_devices frontend motion backend vo selfcal pipeline track_stats"
+TSAN_TESTS="firmware_spsc_queue_test firmware_frame_pool_test firmware_deadline_test
+firmware_mavlink_link_test firmware_rover_devices_test"
+
+stamp() { date +%s; }
+
+# test_targets BUILD_DIR AREA...: the test executables of those areas (<area>_<unit>_test).
+test_targets() {
+  local dir="$1"
+  shift
+  local regex
+  regex="^($(tr ' ' '|' <<<"$*"))_[a-z0-9_]+_test:"
+  ninja -C "${dir}" -t targets all | grep -E "${regex}" | cut -d: -f1 | sort -u
+}
+
+if [ "${run_asan}" -eq 1 ]; then
+  t0=$(stamp)
+  cmake --preset sanitize >/dev/null
+  # shellcheck disable=SC2086
+  mapfile -t targets < <(test_targets build/sanitize ${ASAN_AREAS})
+  cmake --build build/sanitize -j "${jobs}" --target "${targets[@]}"
+  t1=$(stamp)
+  labels="^($(tr -s ' \n' '|' <<<"${ASAN_AREAS}" | sed 's/|$//'))$"
+  ASAN_OPTIONS=detect_leaks=1:halt_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+    ctest --test-dir build/sanitize -j "${jobs}" -L "${labels}" --output-on-failure \
+    --timeout 600
+  echo "test_sanitize: ASan+UBSan ${#targets[@]} test programs: build $((t1 - t0)) s, run $(($(stamp) - t1)) s"
+fi
+
+if [ "${run_tsan}" -eq 1 ]; then
+  t0=$(stamp)
+  cmake --preset tsan >/dev/null
+  # shellcheck disable=SC2086
+  cmake --build build/tsan -j "${jobs}" --target ${TSAN_TESTS}
+  t1=$(stamp)
+  regex='^firmware\.(SpscQueue|FramePool|EventCount|SolverBudget|MavlinkLink|RoverDevices)\.'
+  TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1 \
+    ctest --test-dir build/tsan -j 1 -R "${regex}" --output-on-failure --timeout 600
+  echo "test_sanitize: TSan rover threads: build $((t1 - t0)) s, run $(($(stamp) - t1)) s"
+fi
