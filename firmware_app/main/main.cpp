@@ -4,8 +4,13 @@
 //
 //   sunvo_rover --config config/rover.yaml [--set key=value ...]
 //
-// Exit codes: 0 clean shutdown, 2 bad command line or config, 1 any other start-up failure.
+// Exit codes: 0 clean shutdown, 2 bad command line or config, 1 any other start-up failure or a
+// fault that lasted past health.fault_exit_s (so that systemd's Restart=on-failure fires).
 // --help and --version answer and exit 0.
+//
+// Under systemd (Type=notify, WatchdogSec=): READY=1 once the threads run, WATCHDOG=1 every half
+// $WATCHDOG_USEC while the stages are healthy, STOPPING=1 at the end (rover::Supervisor). Events
+// go to stderr as journal lines with a priority prefix ("<3>" error, "<4>" warning, "<6>" info).
 
 #include <signal.h>
 
@@ -19,8 +24,12 @@
 #include "sunvo/rover/app.hpp"
 #include "sunvo/rover/config.hpp"
 #include "sunvo/rover/mavlink_link.hpp"
+#include "sunvo/rover/supervisor.hpp"
 #include "sunvo/runtime/allocation_meter.hpp"
+#include "sunvo/runtime/clock.hpp"
+#include "sunvo/runtime/event_log.hpp"
 #include "sunvo/runtime/rt_setup.hpp"
+#include "sunvo/runtime/sd_notify.hpp"
 
 #ifdef SUNVO_ALLOC_COUNTER
 #include "sunvo/runtime/alloc_counter.hpp"
@@ -71,6 +80,22 @@ int main(int argc, char** argv) {
     return 2;
   }
   std::printf("%s", config->describe().c_str());
+  std::fflush(stdout);
+  sunvo::runtime::EventLog events("sunvo_rover");
+  events.log(sunvo::runtime::LogPriority::kInfo, "starting (config %s)", config_path.c_str());
+  {
+    std::string warning;
+    const sunvo::Status clock =
+        sunvo::rover::checkClock(config->health, sunvo::rover::readClockState(), &warning);
+    if (!clock.isOk()) {
+      events.log(sunvo::runtime::LogPriority::kErr, "%s", clock.message().c_str());
+      return 1;
+    }
+    if (!warning.empty()) {
+      events.log(sunvo::runtime::LogPriority::kWarning, "%s (health.clock_unsynced: warn)",
+                 warning.c_str());
+    }
+  }
 
   // Before any thread exists: one malloc arena, no mmap blocks, no trimming.
   if (config->rt.heap_reserve_mb > 0) {
@@ -113,6 +138,11 @@ int main(int argc, char** argv) {
   for (const std::string& w : (*app)->start()) std::fprintf(stderr, "sunvo_rover: %s\n", w.c_str());
   std::printf("sunvo_rover: running (pid %d)\n", static_cast<int>(getpid()));
   std::fflush(stdout);
+  sunvo::runtime::SdNotifier notifier = sunvo::runtime::SdNotifier::fromEnvironment();
+  sunvo::rover::Supervisor supervisor(**app, config->health, notifier, events,
+                                      sunvo::runtime::monotonicNs());
+  supervisor.ready();
+  int exit_code = 0;
 
   // RSS once the warm-up frames are through, and at the end: growth = a leak or a buffer that
   // grows.
@@ -139,7 +169,13 @@ int main(int argc, char** argv) {
       rss_warm_kb = residentKb();
     }
     if ((*app)->finished()) break;
+    if (auto code = supervisor.tick(sunvo::runtime::monotonicNs())) {
+      exit_code = *code;
+      reason = "fault exit";
+      break;
+    }
   }
+  supervisor.stopping(reason);
   (*app)->requestStop();
   (*app)->join();
   const long rss_end_kb = residentKb();
@@ -162,5 +198,8 @@ int main(int argc, char** argv) {
                 config->profiling.output_dir.c_str());
   }
   std::fflush(stdout);
-  return 0;
+  events.log(
+      exit_code == 0 ? sunvo::runtime::LogPriority::kInfo : sunvo::runtime::LogPriority::kErr,
+      "exit %d (%s)", exit_code, reason);
+  return exit_code;
 }
