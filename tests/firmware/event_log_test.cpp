@@ -8,6 +8,10 @@
 
 #include <string>
 
+#if defined(SUNVO_HAVE_ALLOC_COUNTER)
+#include "sunvo/runtime/alloc_counter.hpp"
+#endif
+
 namespace sunvo::runtime {
 namespace {
 
@@ -53,6 +57,26 @@ TEST(EventLog, FailedWriteIsCounted) {
   EventLog log("t", -1);
   log.log(LogPriority::kErr, "lost");
   EXPECT_EQ(log.errors(), 1u);
+}
+
+TEST(EventLog, LoggingAllocatesNothing) {
+#if defined(SUNVO_HAVE_ALLOC_COUNTER)
+  ASSERT_TRUE(allocCounterActive());
+  int p[2];
+  ASSERT_EQ(pipe(p), 0);
+  EventLog log("sunvo_rover", p[1]);
+  const std::uint64_t before = threadAllocationCount();
+  for (int i = 0; i < 5; ++i) {
+    log.log(LogPriority::kWarning, "fault: camera %s delivered no frame for %.1f s",
+            "/dev/sunvo-left", 1.0 + i);
+  }
+  EXPECT_EQ(threadAllocationCount() - before, 0u);
+  close(p[1]);
+  EXPECT_NE(drain(p[0]).find("<4>sunvo_rover: fault: camera /dev/sunvo-left"), std::string::npos);
+  close(p[0]);
+#else
+  GTEST_SKIP() << "allocation counter not linked (sanitizer build)";
+#endif
 }
 
 }  // namespace

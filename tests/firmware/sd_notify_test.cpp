@@ -13,6 +13,10 @@
 #include <filesystem>
 #include <string>
 
+#if defined(SUNVO_HAVE_ALLOC_COUNTER)
+#include "sunvo/runtime/alloc_counter.hpp"
+#endif
+
 namespace sunvo::runtime {
 namespace {
 
@@ -118,6 +122,27 @@ TEST(SdNotify, BadSocketNameIsCountedNotFatal) {
   EXPECT_FALSE(n.enabled());
   EXPECT_EQ(n.errors(), 1u);
   unsetenv("NOTIFY_SOCKET");
+}
+
+TEST(SdNotify, SendsAllocateNothing) {
+#if defined(SUNVO_HAVE_ALLOC_COUNTER)
+  ASSERT_TRUE(allocCounterActive());
+  const std::string name = "@sunvo_sd_notify_alloc_" + std::to_string(getpid());
+  Listener listener(name);
+  ASSERT_TRUE(listener.bound());
+  setenv("NOTIFY_SOCKET", name.c_str(), 1);
+  SdNotifier n = SdNotifier::fromEnvironment();
+  unsetenv("NOTIFY_SOCKET");
+  const std::uint64_t before = threadAllocationCount();
+  for (int i = 0; i < 5; ++i) {
+    EXPECT_TRUE(n.watchdog());
+    EXPECT_TRUE(n.status("camera /dev/sunvo-left delivered no frame for 1.0 s"));
+  }
+  EXPECT_EQ(threadAllocationCount() - before, 0u);
+  EXPECT_EQ(n.sent(), 10u);
+#else
+  GTEST_SKIP() << "allocation counter not linked (sanitizer build)";
+#endif
 }
 
 }  // namespace
