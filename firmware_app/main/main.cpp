@@ -74,33 +74,33 @@ int main(int argc, char** argv) {
     const auto eq = kv.find('=');
     overrides.emplace_back(kv.substr(0, eq), kv.substr(eq + 1));
   }
+  using sunvo::runtime::LogPriority;
+  sunvo::runtime::EventLog events("sunvo_rover");
   auto config = sunvo::rover::loadRoverConfig(config_path, overrides);
   if (!config) {
-    std::fprintf(stderr, "sunvo_rover: %s\n", config.status().message().c_str());
+    events.log(LogPriority::kErr, "%s", config.status().message().c_str());
     return 2;
   }
   std::printf("%s", config->describe().c_str());
   std::fflush(stdout);
-  sunvo::runtime::EventLog events("sunvo_rover");
-  events.log(sunvo::runtime::LogPriority::kInfo, "starting (config %s)", config_path.c_str());
+  events.log(LogPriority::kInfo, "starting (config %s)", config_path.c_str());
   {
     std::string warning;
     const sunvo::Status clock =
         sunvo::rover::checkClock(config->health, sunvo::rover::readClockState(), &warning);
     if (!clock.isOk()) {
-      events.log(sunvo::runtime::LogPriority::kErr, "%s", clock.message().c_str());
+      events.log(LogPriority::kErr, "%s", clock.message().c_str());
       return 1;
     }
     if (!warning.empty()) {
-      events.log(sunvo::runtime::LogPriority::kWarning, "%s (health.clock_unsynced: warn)",
-                 warning.c_str());
+      events.log(LogPriority::kWarning, "%s (health.clock_unsynced: warn)", warning.c_str());
     }
   }
 
   // Before any thread exists: one malloc arena, no mmap blocks, no trimming.
   if (config->rt.heap_reserve_mb > 0) {
     const std::string w = sunvo::runtime::configureRealTimeHeap();
-    if (!w.empty()) std::fprintf(stderr, "sunvo_rover: %s\n", w.c_str());
+    if (!w.empty()) events.log(LogPriority::kWarning, "%s", w.c_str());
   }
 #ifdef SUNVO_ALLOC_COUNTER
   sunvo::runtime::setThreadAllocationProbe(&sunvo::runtime::threadAllocationCount);
@@ -118,7 +118,7 @@ int main(int argc, char** argv) {
   if (!config->serial.device.empty()) {
     auto l = sunvo::rover::MavlinkSerialLink::open(config->serial, config->telemetry);
     if (!l) {
-      std::fprintf(stderr, "sunvo_rover: serial.device: %s\n", l.status().message().c_str());
+      events.log(LogPriority::kErr, "serial.device: %s", l.status().message().c_str());
       return 1;
     }
     link = std::move(*l);
@@ -126,16 +126,16 @@ int main(int argc, char** argv) {
   auto app =
       sunvo::rover::RoverApp::create(*config, std::move(link), sunvo::rover::productionDevices());
   if (!app) {
-    std::fprintf(stderr, "sunvo_rover: %s\n", app.status().message().c_str());
+    events.log(LogPriority::kErr, "%s", app.status().message().c_str());
     return app.status().code() == sunvo::StatusCode::kInvalidArgument ? 2 : 1;
   }
   {
     const std::string w =
         sunvo::runtime::reserveHeap(static_cast<std::size_t>(config->rt.heap_reserve_mb) << 20);
-    if (!w.empty()) std::fprintf(stderr, "sunvo_rover: %s\n", w.c_str());
+    if (!w.empty()) events.log(LogPriority::kWarning, "%s", w.c_str());
   }
   const long rss_start_kb = residentKb();  // every buffer allocated, threads not started
-  for (const std::string& w : (*app)->start()) std::fprintf(stderr, "sunvo_rover: %s\n", w.c_str());
+  for (const std::string& w : (*app)->start()) events.log(LogPriority::kWarning, "%s", w.c_str());
   std::printf("sunvo_rover: running (pid %d)\n", static_cast<int>(getpid()));
   std::fflush(stdout);
   sunvo::runtime::SdNotifier notifier = sunvo::runtime::SdNotifier::fromEnvironment();
@@ -156,8 +156,8 @@ int main(int argc, char** argv) {
     const int sig = sigtimedwait(&signals, nullptr, &tick);
     if (sig == SIGUSR1) {
       auto text = (*app)->writeProfile("sigusr1_" + std::to_string(++dumps));
-      std::fprintf(stderr, "sunvo_rover: SIGUSR1: profile %s\n",
-                   text ? "written" : text.status().message().c_str());
+      events.log(text ? LogPriority::kInfo : LogPriority::kWarning, "SIGUSR1: profile %s",
+                 text ? "written" : text.status().message().c_str());
       continue;
     }
     if (sig == SIGINT || sig == SIGTERM) {
@@ -192,14 +192,13 @@ int main(int argc, char** argv) {
                 rss_end_kb);
   }
   if (!profile) {
-    std::fprintf(stderr, "sunvo_rover: profile: %s\n", profile.status().message().c_str());
+    events.log(LogPriority::kWarning, "profile: %s", profile.status().message().c_str());
   } else {
     std::printf("  profile: %s/final_latency.csv, final_trace.json, final_latency_summary.txt\n",
                 config->profiling.output_dir.c_str());
   }
   std::fflush(stdout);
-  events.log(
-      exit_code == 0 ? sunvo::runtime::LogPriority::kInfo : sunvo::runtime::LogPriority::kErr,
-      "exit %d (%s)", exit_code, reason);
+  events.log(exit_code == 0 ? LogPriority::kInfo : LogPriority::kErr, "exit %d (%s)", exit_code,
+             reason);
   return exit_code;
 }
