@@ -185,7 +185,7 @@ if [ "${has_rover}" -eq 1 ]; then
   [ -x "${WORK}/root${exec_bin}" ] || bad "ExecStart program ${exec_bin} is not in the package"
   [ -f "${WORK}/root${config}" ] || bad "ExecStart config ${config} is not in the package"
 fi
-for key in Restart=on-failure RestartSec= LimitRTPRIO= LimitMEMLOCK=infinity User=sunvo \
+for key in Restart=on-failure RestartSec= LimitRTPRIO= LimitMEMLOCK=infinity User=sunvo Type=notify WatchdogSec= \
   "SupplementaryGroups=video gpio dialout"; do
   grep -q "^${key}" "${unit}" || bad "sunvo.service has no ${key}"
 done

@@ -4,8 +4,13 @@
 //
 //   sunvo_rover --config config/rover.yaml [--set key=value ...]
 //
-// Exit codes: 0 clean shutdown, 2 bad command line or config, 1 any other start-up failure.
+// Exit codes: 0 clean shutdown, 2 bad command line or config, 1 any other start-up failure or a
+// fault that lasted past health.fault_exit_s (so that systemd's Restart=on-failure fires).
 // --help and --version answer and exit 0.
+//
+// Under systemd (Type=notify, WatchdogSec=): READY=1 once the threads run, WATCHDOG=1 every half
+// $WATCHDOG_USEC while the stages are healthy, STOPPING=1 at the end (rover::Supervisor). Events
+// go to stderr as journal lines with a priority prefix ("<3>" error, "<4>" warning, "<6>" info).
 
 #include <signal.h>
 
@@ -19,8 +24,12 @@
 #include "sunvo/rover/app.hpp"
 #include "sunvo/rover/config.hpp"
 #include "sunvo/rover/mavlink_link.hpp"
+#include "sunvo/rover/supervisor.hpp"
 #include "sunvo/runtime/allocation_meter.hpp"
+#include "sunvo/runtime/clock.hpp"
+#include "sunvo/runtime/event_log.hpp"
 #include "sunvo/runtime/rt_setup.hpp"
+#include "sunvo/runtime/sd_notify.hpp"
 
 #ifdef SUNVO_ALLOC_COUNTER
 #include "sunvo/runtime/alloc_counter.hpp"
@@ -65,17 +74,33 @@ int main(int argc, char** argv) {
     const auto eq = kv.find('=');
     overrides.emplace_back(kv.substr(0, eq), kv.substr(eq + 1));
   }
+  using sunvo::runtime::LogPriority;
+  sunvo::runtime::EventLog events("sunvo_rover");
   auto config = sunvo::rover::loadRoverConfig(config_path, overrides);
   if (!config) {
-    std::fprintf(stderr, "sunvo_rover: %s\n", config.status().message().c_str());
+    events.log(LogPriority::kErr, "%s", config.status().message().c_str());
     return 2;
   }
   std::printf("%s", config->describe().c_str());
+  std::fflush(stdout);
+  events.log(LogPriority::kInfo, "starting (config %s)", config_path.c_str());
+  {
+    std::string warning;
+    const sunvo::Status clock =
+        sunvo::rover::checkClock(config->health, sunvo::rover::readClockState(), &warning);
+    if (!clock.isOk()) {
+      events.log(LogPriority::kErr, "%s", clock.message().c_str());
+      return 1;
+    }
+    if (!warning.empty()) {
+      events.log(LogPriority::kWarning, "%s (health.clock_unsynced: warn)", warning.c_str());
+    }
+  }
 
   // Before any thread exists: one malloc arena, no mmap blocks, no trimming.
   if (config->rt.heap_reserve_mb > 0) {
     const std::string w = sunvo::runtime::configureRealTimeHeap();
-    if (!w.empty()) std::fprintf(stderr, "sunvo_rover: %s\n", w.c_str());
+    if (!w.empty()) events.log(LogPriority::kWarning, "%s", w.c_str());
   }
 #ifdef SUNVO_ALLOC_COUNTER
   sunvo::runtime::setThreadAllocationProbe(&sunvo::runtime::threadAllocationCount);
@@ -93,7 +118,7 @@ int main(int argc, char** argv) {
   if (!config->serial.device.empty()) {
     auto l = sunvo::rover::MavlinkSerialLink::open(config->serial, config->telemetry);
     if (!l) {
-      std::fprintf(stderr, "sunvo_rover: serial.device: %s\n", l.status().message().c_str());
+      events.log(LogPriority::kErr, "serial.device: %s", l.status().message().c_str());
       return 1;
     }
     link = std::move(*l);
@@ -101,18 +126,23 @@ int main(int argc, char** argv) {
   auto app =
       sunvo::rover::RoverApp::create(*config, std::move(link), sunvo::rover::productionDevices());
   if (!app) {
-    std::fprintf(stderr, "sunvo_rover: %s\n", app.status().message().c_str());
+    events.log(LogPriority::kErr, "%s", app.status().message().c_str());
     return app.status().code() == sunvo::StatusCode::kInvalidArgument ? 2 : 1;
   }
   {
     const std::string w =
         sunvo::runtime::reserveHeap(static_cast<std::size_t>(config->rt.heap_reserve_mb) << 20);
-    if (!w.empty()) std::fprintf(stderr, "sunvo_rover: %s\n", w.c_str());
+    if (!w.empty()) events.log(LogPriority::kWarning, "%s", w.c_str());
   }
   const long rss_start_kb = residentKb();  // every buffer allocated, threads not started
-  for (const std::string& w : (*app)->start()) std::fprintf(stderr, "sunvo_rover: %s\n", w.c_str());
+  for (const std::string& w : (*app)->start()) events.log(LogPriority::kWarning, "%s", w.c_str());
   std::printf("sunvo_rover: running (pid %d)\n", static_cast<int>(getpid()));
   std::fflush(stdout);
+  sunvo::runtime::SdNotifier notifier = sunvo::runtime::SdNotifier::fromEnvironment();
+  sunvo::rover::Supervisor supervisor(**app, config->health, notifier, events,
+                                      sunvo::runtime::monotonicNs());
+  supervisor.ready();
+  int exit_code = 0;
 
   // RSS once the warm-up frames are through, and at the end: growth = a leak or a buffer that
   // grows.
@@ -126,8 +156,8 @@ int main(int argc, char** argv) {
     const int sig = sigtimedwait(&signals, nullptr, &tick);
     if (sig == SIGUSR1) {
       auto text = (*app)->writeProfile("sigusr1_" + std::to_string(++dumps));
-      std::fprintf(stderr, "sunvo_rover: SIGUSR1: profile %s\n",
-                   text ? "written" : text.status().message().c_str());
+      events.log(text ? LogPriority::kInfo : LogPriority::kWarning, "SIGUSR1: profile %s",
+                 text ? "written" : text.status().message().c_str());
       continue;
     }
     if (sig == SIGINT || sig == SIGTERM) {
@@ -139,10 +169,19 @@ int main(int argc, char** argv) {
       rss_warm_kb = residentKb();
     }
     if ((*app)->finished()) {
-      if ((*app)->sourceFailed()) reason = "the frame source failed persistently";
+      if ((*app)->sourceFailed()) {
+        exit_code = 1;
+        reason = "the frame source failed persistently";
+      }
+      break;
+    }
+    if (auto code = supervisor.tick(sunvo::runtime::monotonicNs())) {
+      exit_code = *code;
+      reason = "fault exit";
       break;
     }
   }
+  supervisor.stopping(reason);
   (*app)->requestStop();
   (*app)->join();
   const long rss_end_kb = residentKb();
@@ -159,11 +198,13 @@ int main(int argc, char** argv) {
                 rss_end_kb);
   }
   if (!profile) {
-    std::fprintf(stderr, "sunvo_rover: profile: %s\n", profile.status().message().c_str());
+    events.log(LogPriority::kWarning, "profile: %s", profile.status().message().c_str());
   } else {
     std::printf("  profile: %s/final_latency.csv, final_trace.json, final_latency_summary.txt\n",
                 config->profiling.output_dir.c_str());
   }
   std::fflush(stdout);
-  return (*app)->sourceFailed() ? 1 : 0;
+  events.log(exit_code == 0 ? LogPriority::kInfo : LogPriority::kErr, "exit %d (%s)", exit_code,
+             reason);
+  return exit_code;
 }

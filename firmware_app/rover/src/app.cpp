@@ -308,6 +308,30 @@ std::uint64_t RoverApp::framesProcessed() const {
   return impl_->health.frames_processed.load(std::memory_order_relaxed);
 }
 
+HealthSample RoverApp::healthSample(TimeNs now) const {
+  const Impl& s = *impl_;
+  const Health& h = s.health;
+  auto g = [](const std::atomic<std::uint64_t>& a) { return a.load(std::memory_order_relaxed); };
+  HealthSample out;
+  out.now_ns = now;
+  out.frames_grabbed = g(h.frames_grabbed);
+  out.grab_errors = g(h.grab_errors);
+  out.trigger_timeouts = g(h.trigger_timeouts);
+  out.frames_processed = g(h.frames_processed);
+  out.lost_frames = g(h.lost_frames);
+  out.poses_published = g(h.poses_published);
+  out.source_ended = s.channels.capture_done.load(std::memory_order_acquire);
+  out.estimator_done = s.channels.estimator_done.load(std::memory_order_acquire);
+  return out;
+}
+
+std::string RoverApp::cameraName() const {
+  const SourceConfig& src = impl_->config.source;
+  if (src.type == SourceType::kKitti) return "replay " + src.kitti.drive_dir;
+  if (src.v4l2.layout == v4l2::V4l2Layout::kSideBySide) return src.v4l2.left_device;
+  return src.v4l2.left_device + " + " + src.v4l2.right_device;
+}
+
 std::string RoverApp::summary() const {
   const Impl& s = *impl_;
   const Health& h = s.health;

@@ -239,6 +239,10 @@ std::span<const std::string_view> enumNames(WorldInit) {
   static constexpr std::string_view kNames[] = {"oxts", "config"};
   return kNames;
 }
+std::span<const std::string_view> enumNames(ClockUnsyncedAction) {
+  static constexpr std::string_view kNames[] = {"warn", "refuse"};
+  return kNames;
+}
 std::span<const std::string_view> enumNames(SunProviderType) {
   static constexpr std::string_view kNames[] = {"none", "csv", "lalonde", "lalonde_vo", "sun_cnn"};
   return kNames;
@@ -356,6 +360,9 @@ Status RoverConfig::validate() const {
       checkOpenLow("telemetry.pose_timeout_s", telemetry.pose_timeout_s, 0.0, 60.0));
   SUNVO_RETURN_IF_ERROR(
       checkRange("telemetry.pose_log_buffer_kb", telemetry.pose_log_buffer_kb, 1, 65536));
+  SUNVO_RETURN_IF_ERROR(checkRange("health.fault_exit_s", health.fault_exit_s, 0.0, 3600.0));
+  SUNVO_RETURN_IF_ERROR(
+      checkOpenLow("health.watchdog_pose_age_s", health.watchdog_pose_age_s, 0.0, 60.0));
   SUNVO_RETURN_IF_ERROR(checkRange("rt.heap_reserve_mb", rt.heap_reserve_mb, 0, 4096));
   SUNVO_RETURN_IF_ERROR(rt.threads.capture.validate("rt.threads.capture"));
   SUNVO_RETURN_IF_ERROR(rt.threads.estimator.validate("rt.threads.estimator"));

@@ -33,6 +33,7 @@
 #include "sunvo/core/status.hpp"
 #include "sunvo/gpio/gpio_api.hpp"
 #include "sunvo/rover/config.hpp"
+#include "sunvo/rover/health_watch.hpp"
 #include "sunvo/rover/pose_link.hpp"
 #include "sunvo/rover/sources.hpp"
 #include "sunvo/rover/sun_provider.hpp"
@@ -81,6 +82,10 @@ class RoverApp {
   bool sourceFailed() const;
   // Frames the estimator has processed so far (any thread).
   std::uint64_t framesProcessed() const;
+  // The health counters at `now` (monotonic), for HealthWatch (any thread, no allocation).
+  HealthSample healthSample(TimeNs now) const;
+  // The frame source in words: the V4L2 device(s), or "replay <drive_dir>".
+  std::string cameraName() const;
 
   // Final summary: frames, drops per queue, deadline misses, tracking, sun, serial, latency.
   std::string summary() const;

@@ -61,12 +61,15 @@ enum class WorldInit {
 // none: pure VO; csv: a per-frame file; lalonde / lalonde_vo: sunvision::LalondeEstimator with the
 // zenith / the VO attitude as prior; sun_cnn: suncnn::SunCnnEstimator (ONNX model at sun.model).
 enum class SunProviderType { kNone, kCsv, kLalonde, kLalondeVo, kSunCnn };
+// What start-up does when the kernel says the system clock is not synchronised (adjtimex).
+enum class ClockUnsyncedAction { kWarn, kRefuse };
 
 std::span<const std::string_view> enumNames(SourceType);
 std::span<const std::string_view> enumNames(TriggerType);
 std::span<const std::string_view> enumNames(EndAction);
 std::span<const std::string_view> enumNames(WorldInit);
 std::span<const std::string_view> enumNames(SunProviderType);
+std::span<const std::string_view> enumNames(ClockUnsyncedAction);
 
 struct KittiSourceConfig {
   std::string drive_dir;          // KITTI raw drive folder (<date>/<date>_drive_NNNN_sync)
@@ -271,6 +274,23 @@ struct TelemetryConfig {
   }
 };
 
+// Field health (health_watch.hpp): when to give up so that systemd's Restart=on-failure fires.
+struct HealthConfig {
+  // s, [0, 3600]: a fault (the camera delivers no frame, the estimator is lost on every frame,
+  // no pose is published) that lasts this long ends the program with exit code 3; 0 = never.
+  double fault_exit_s = 10.0;
+  // s, (0, 60]: the watchdog (WATCHDOG=1) is fed only while the last pose is younger than this.
+  double watchdog_pose_age_s = 2.0;
+  // warn | refuse: the system clock is not synchronised at start-up (the sun's UTC is unchecked).
+  ClockUnsyncedAction clock_unsynced = ClockUnsyncedAction::kWarn;
+  template <class Self, class V>
+  static void fields(Self& s, V& v) {
+    v("fault_exit_s", s.fault_exit_s);
+    v("watchdog_pose_age_s", s.watchdog_pose_age_s);
+    v("clock_unsynced", s.clock_unsynced);
+  }
+};
+
 struct ThreadsConfig {
   runtime::ThreadPolicy capture{80, -1};
   runtime::ThreadPolicy estimator{70, -1};
@@ -327,6 +347,7 @@ struct RoverConfig {
   SunConfig sun;
   SerialConfig serial;
   TelemetryConfig telemetry;
+  HealthConfig health;
   RtConfig rt;
   ProfilingConfig profiling;
 
@@ -346,6 +367,7 @@ struct RoverConfig {
     v("sun", s.sun);
     v("serial", s.serial);
     v("telemetry", s.telemetry);
+    v("health", s.health);
     v("rt", s.rt);
     v("profiling", s.profiling);
   }

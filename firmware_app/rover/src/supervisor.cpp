@@ -1,0 +1,51 @@
+#include "sunvo/rover/supervisor.hpp"
+
+namespace sunvo::rover {
+
+Supervisor::Supervisor(const RoverApp& app, const HealthConfig& config,
+                       runtime::SdNotifier& notifier, runtime::EventLog& log, TimeNs start_ns)
+    : app_(app),
+      notifier_(notifier),
+      log_(log),
+      watch_(config, start_ns, app.cameraName()),
+      ping_period_ns_(notifier.watchdogNs() / 2),
+      next_ping_ns_(start_ns) {}
+
+void Supervisor::ready() {
+  notifier_.ready();
+  notifier_.status("running");
+  log_.log(runtime::LogPriority::kInfo, "ready: 4 stages running, watchdog %s",
+           ping_period_ns_ > 0 ? "on" : "off");
+}
+
+std::optional<int> Supervisor::tick(TimeNs now) {
+  const HealthFault fault = watch_.update(app_.healthSample(now));
+  if (fault != logged_) {
+    if (fault == HealthFault::kNone) {
+      log_.log(runtime::LogPriority::kInfo, "recovered from fault (%s)", healthFaultName(logged_));
+      notifier_.status("running");
+    } else {
+      log_.log(runtime::LogPriority::kWarning, "fault: %s", watch_.reason());
+      notifier_.status(watch_.reason());
+    }
+    logged_ = fault;
+  }
+  if (watch_.mustExit()) {
+    log_.log(runtime::LogPriority::kErr, "fault exit (health.fault_exit_s exceeded): %s",
+             watch_.reason());
+    notifier_.status(watch_.reason());
+    return kFaultExitCode;
+  }
+  if (ping_period_ns_ > 0 && now >= next_ping_ns_ && watch_.healthy()) {
+    if (notifier_.watchdog()) ++pings_;
+    next_ping_ns_ = now + ping_period_ns_;
+  }
+  return std::nullopt;
+}
+
+void Supervisor::stopping(const char* why) {
+  notifier_.stopping();
+  log_.log(runtime::LogPriority::kInfo, "stopping (%s)", why);
+}
+
+}  // namespace sunvo::rover
