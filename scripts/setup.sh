@@ -11,7 +11,14 @@ PACKAGES=(
 # node-mavlink (npm) decodes our MAVLink stream in the tests; installed only when node/npm is missing.
 if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then PACKAGES+=(nodejs npm); fi
 # --train: also the optional Sun-CNN training tools (large; CI only runs OpenCV DNN inference).
-if [ "${1:-}" = "--train" ]; then PACKAGES+=(python3-torch python3-opencv); fi
+# --sanitize: clang-14 and its libFuzzer runtime for the fuzz harnesses (scripts/fuzz.sh).
+for arg in "$@"; do
+  case "$arg" in
+    --train) PACKAGES+=(python3-torch python3-opencv) ;;
+    --sanitize) PACKAGES+=(clang-14 libclang-rt-14-dev) ;;
+    *) echo "usage: $0 [--train] [--sanitize]" >&2; exit 2 ;;
+  esac
+done
 
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -6,11 +6,13 @@
 #     the sun fusion and the pipeline on real KITTI frames);
 #  2. ThreadSanitizer (preset tsan) over the rover's threads: the SPSC rings, the frame pool, the
 #     MAVLink link and the whole-program tests of sunvo_rover on emulated devices (capture,
-#     estimator, sun and telemetry threads).
+#     estimator, sun and telemetry threads);
+#  3. the short fuzz run: every libFuzzer harness of tests/fuzz for 10 s (scripts/fuzz.sh; the long
+#     run and its results: docs/hardening.md).
 # The areas left out start other programs through the shell (their tests exercise the same
 # libraries) or render with POV-Ray (minutes per test under a sanitizer).
 #
-#   scripts/test_sanitize.sh [--asan-only | --tsan-only]
+#   scripts/test_sanitize.sh [--asan-only | --tsan-only | --fuzz-only]
 #
 # Exit status: non-zero when a build fails or a sanitizer reports an error (the sanitizers abort
 # the test on the first report: -fno-sanitize-recover=all, halt_on_error=1).
@@ -19,12 +21,15 @@ cd "$(dirname "$0")/.."
 jobs=$(nproc)
 run_asan=1
 run_tsan=1
+run_fuzz=1
 case "${1:-}" in
-  --asan-only) run_tsan=0 ;;
-  --tsan-only) run_asan=0 ;;
+  --asan-only) run_tsan=0; run_fuzz=0 ;;
+  --tsan-only) run_asan=0; run_fuzz=0 ;;
+  --fuzz-only) run_asan=0; run_tsan=0 ;;
   "") ;;
-  *) echo "usage: $0 [--asan-only | --tsan-only]" >&2; exit 2 ;;
+  *) echo "usage: $0 [--asan-only | --tsan-only | --fuzz-only]" >&2; exit 2 ;;
 esac
+bash scripts/setup.sh --sanitize
 
 ASAN_AREAS="core files kitti dataset geodesy metrics sun sunfusion mavlink serial sysio v4l2 gpio
 emulated_devices frontend motion backend vo selfcal pipeline track_stats"
@@ -82,4 +87,10 @@ if [ "${run_tsan}" -eq 1 ]; then
   fi
   echo "test_sanitize: rover whole-program tests under TSan: no race reported (test exit ${code})"
   echo "test_sanitize: TSan rover threads: build $((t1 - t0)) s, run $(($(stamp) - t1)) s"
+fi
+
+if [ "${run_fuzz}" -eq 1 ]; then
+  t0=$(stamp)
+  bash scripts/fuzz.sh 10
+  echo "test_sanitize: fuzz short run (build and 10 s per harness) $(($(stamp) - t0)) s"
 fi
