@@ -44,7 +44,7 @@ Status PipelineOptions::validate() const {
 }
 
 Status StereoImageOdometry::init(const PipelineOptions& options, const StereoCamera& camera,
-                                  const Isometry3& T_w_c0) {
+                                 const Isometry3& T_w_c0) {
   initialized_ = false;
   SUNVO_RETURN_IF_ERROR(options.validate());
   SUNVO_RETURN_IF_ERROR(camera.validate());

@@ -59,7 +59,7 @@ Status VoOptions::validate() const {
 }
 
 Status StereoTrackOdometry::init(const VoOptions& options, const StereoCamera& camera,
-                            const Isometry3& T_w_c0) {
+                                 const Isometry3& T_w_c0) {
   SUNVO_RETURN_IF_ERROR(options.validate());
   SUNVO_RETURN_IF_ERROR(camera.validate());
   if (!allFinite(T_w_c0)) return invalidArgument("vo: non-finite T_w_c0");

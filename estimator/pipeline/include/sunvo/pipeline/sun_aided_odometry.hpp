@@ -36,7 +36,8 @@ struct SunAidedOptions {
   int every_n_frames = 5;              // a sun measurement every n-th frame, [1, 1000]
   sunfusion::SunFusionOptions fusion;  // gate, world "up", attitude model (sun_window_term.hpp)
 
-  // The error names the bad key relative to these options ("every_n_frames", "fusion.x", "window.x").
+  // The error names the bad key relative to these options ("every_n_frames", "fusion.x",
+  // "window.x").
   Status validate() const;
   // The pipeline's fields are listed at this level; use_sun is the program's to set (the rover:
   // sun.provider).
@@ -94,7 +95,7 @@ class SunAidedOdometry {
 
   SunAidedOptions options_;
   OdometryInput input_ = OdometryInput::kImages;
-  StereoImageOdometry vo_;    // image input: front end + its own back end
+  StereoImageOdometry vo_;          // image input: front end + its own back end
   vo::StereoTrackOdometry tracks_;  // feature input: the back end alone
   sunfusion::SunWindowTerm sun_term_;
   Isometry3 T_w_c_ = Isometry3::Identity();
