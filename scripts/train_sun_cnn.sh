@@ -22,7 +22,8 @@ if [ ! -x "$BUILD/bin/sunvo_render" ]; then
 fi
 
 mkdir -p "$RENDERS"
-for yaml in "$ROOT"/config/scenarios/train_*.yaml "$ROOT"/config/scenarios/val_*.yaml; do
+for yaml in "$ROOT"/config/scenarios/train_*.yaml "$ROOT"/config/scenarios/val_*.yaml \
+  "$ROOT"/config/scenarios/test_*.yaml; do
   name="$(basename "$yaml" .yaml)"
   out="$RENDERS/$name"
   # RENDERED holds the SHA-256 of the scenario it was rendered from: a changed scenario renders again.

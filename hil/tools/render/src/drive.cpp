@@ -24,19 +24,6 @@ namespace sunvo::render {
 namespace {
 constexpr double kPi = std::numbers::pi;
 
-Status range(const std::string& key, const char* r) {
-  return invalidArgument(key + " out of range " + r);
-}
-
-// sRGB transfer function and its inverse (IEC 61966-2-1).
-double srgbToLinear(double c) {
-  return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
-}
-double linearToSrgb(double l) {
-  l = std::clamp(l, 0.0, 1.0);
-  return l <= 0.0031308 ? 12.92 * l : 1.055 * std::pow(l, 1.0 / 2.4) - 0.055;
-}
-
 Status writeText(const std::string& path, const std::string& text) {
   std::ofstream f(path);
   if (!f) return ioError("cannot write " + path);
@@ -57,198 +44,7 @@ std::string row3x4(const Isometry3& T) {
   return s;
 }
 
-// --- YAML helpers: every key is checked against the allowed set and its value parsed with
-// the key named in the error. yaml-cpp throws; the exceptions stop here.
-struct Reader {
-  std::string label;
-  Status st;
-  void keys(const YAML::Node& n, const std::string& sec, const std::set<std::string>& allowed) {
-    if (!st.isOk() || !n) return;
-    if (!n.IsMap()) {
-      st = invalidArgument(label + ": " + (sec.empty() ? "top level" : sec) + " must be a map");
-      return;
-    }
-    for (const auto& kv : n) {
-      const std::string k = kv.first.as<std::string>();
-      if (allowed.count(k) == 0) {
-        st = invalidArgument(label + ": unknown key '" + (sec.empty() ? k : sec + "." + k) + "'");
-        return;
-      }
-    }
-  }
-  template <typename T>
-  void get(const YAML::Node& n, const std::string& sec, const char* key, T& out) {
-    if (!st.isOk() || !n || !n[key]) return;
-    try {
-      out = n[key].as<T>();
-    } catch (const YAML::Exception&) {
-      st = invalidArgument(label + ": key '" + sec + (sec.empty() ? "" : ".") + key +
-                           "': not a valid value");
-    }
-  }
-};
 }  // namespace
-
-Status SensorOptions::validate() const {
-  if (!(full_well_e == 0.0 || (full_well_e >= 100 && full_well_e <= 1e6)))
-    return range("sensor.full_well_e", "0 or [100, 1e6]");
-  if (!(read_noise_e >= 0 && read_noise_e <= 1000))
-    return range("sensor.read_noise_e", "[0, 1000]");
-  if (!(vignetting >= 0 && vignetting <= 1)) return range("sensor.vignetting", "[0, 1]");
-  if (!(exposure_sigma >= 0 && exposure_sigma <= 0.5))
-    return range("sensor.exposure_sigma", "[0, 0.5]");
-  if (!(exposure_target > 0 && exposure_target <= 1))
-    return range("sensor.exposure_target", "(0, 1]");
-  if (!(motion_blur_px >= 0 && motion_blur_px <= 20))
-    return range("sensor.motion_blur_px", "[0, 20]");
-  return Status::ok();
-}
-
-Status CalibErrorOptions::validate() const {
-  if (!(focal_scale >= 0.9 && focal_scale <= 1.1))
-    return range("calib_error.focal_scale", "[0.9, 1.1]");
-  if (!(cu_offset_px >= -20 && cu_offset_px <= 20))
-    return range("calib_error.cu_offset_px", "[-20, 20]");
-  if (!(cv_offset_px >= -20 && cv_offset_px <= 20))
-    return range("calib_error.cv_offset_px", "[-20, 20]");
-  if (!(baseline_scale >= 0.9 && baseline_scale <= 1.1))
-    return range("calib_error.baseline_scale", "[0.9, 1.1]");
-  return Status::ok();
-}
-
-Status Scenario::validate() const {
-  if (name.empty() || name.find('/') != std::string::npos)
-    return invalidArgument("name: empty or contains '/'");
-  if (!(drive_number >= 0 && drive_number <= 9999)) return range("drive_number", "[0, 9999]");
-  if (!(latitude_deg >= -90 && latitude_deg <= 90)) return range("place.latitude_deg", "[-90, 90]");
-  if (!(longitude_deg >= -180 && longitude_deg <= 180))
-    return range("place.longitude_deg", "[-180, 180]");
-  if (!(altitude_m >= -500 && altitude_m <= 9000)) return range("place.altitude_m", "[-500, 9000]");
-  if (!(frames >= 1 && frames <= 100000)) return range("frames", "[1, 100000]");
-  if (!(sky_image_width >= 32 && sky_image_width <= 4096))
-    return range("sky.image_width", "[32, 4096]");
-  SUNVO_RETURN_IF_ERROR(sky.validate());
-  SUNVO_RETURN_IF_ERROR(city.validate());
-  SUNVO_RETURN_IF_ERROR(route.validate());
-  if (auto st = camera.validate(); !st.isOk()) return invalidArgument("camera: " + st.message());
-  SUNVO_RETURN_IF_ERROR(quality.validate());
-  SUNVO_RETURN_IF_ERROR(sensor.validate());
-  SUNVO_RETURN_IF_ERROR(calib_error.validate());
-  return Status::ok();
-}
-
-Expected<Scenario> parseScenario(const std::string& text, const std::string& label) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    return parseError(label + ": YAML: " + e.what());
-  }
-  Scenario s;
-  Reader r{label, {}};
-  try {
-    r.keys(root, "",
-           {"name", "drive_number", "place", "start_utc", "frames", "seed", "sky", "city", "route",
-            "camera", "render", "sensor", "calib_error"});
-    r.get(root, "", "name", s.name);
-    r.get(root, "", "drive_number", s.drive_number);
-    r.get(root, "", "frames", s.frames);
-    r.get(root, "", "seed", s.seed);
-    std::string start = "2011-09-26 13:00:00";
-    r.get(root, "", "start_utc", start);
-    if (r.st.isOk()) {
-      auto t = parseCivilTime(start, 0);
-      if (!t) return invalidArgument(label + ": key 'start_utc': " + t.status().message());
-      s.start_utc = *t;
-    }
-    const YAML::Node place = root["place"];
-    r.keys(place, "place", {"latitude_deg", "longitude_deg", "altitude_m"});
-    r.get(place, "place", "latitude_deg", s.latitude_deg);
-    r.get(place, "place", "longitude_deg", s.longitude_deg);
-    r.get(place, "place", "altitude_m", s.altitude_m);
-    const YAML::Node sky = root["sky"];
-    r.keys(sky, "sky", {"turbidity", "image_width"});
-    r.get(sky, "sky", "turbidity", s.sky.turbidity);
-    r.get(sky, "sky", "image_width", s.sky_image_width);
-    const YAML::Node c = root["city"];
-    r.keys(c, "city",
-           {"blocks_x", "blocks_y", "block_size_m", "street_width_m", "sidewalk_width_m",
-            "min_height_m", "max_height_m", "min_lot_m", "max_lot_m", "pole_spacing_m",
-            "tree_probability", "parked_car_probability"});
-    r.get(c, "city", "blocks_x", s.city.blocks_x);
-    r.get(c, "city", "blocks_y", s.city.blocks_y);
-    r.get(c, "city", "block_size_m", s.city.block_size_m);
-    r.get(c, "city", "street_width_m", s.city.street_width_m);
-    r.get(c, "city", "sidewalk_width_m", s.city.sidewalk_width_m);
-    r.get(c, "city", "min_height_m", s.city.min_height_m);
-    r.get(c, "city", "max_height_m", s.city.max_height_m);
-    r.get(c, "city", "min_lot_m", s.city.min_lot_m);
-    r.get(c, "city", "max_lot_m", s.city.max_lot_m);
-    r.get(c, "city", "pole_spacing_m", s.city.pole_spacing_m);
-    r.get(c, "city", "tree_probability", s.city.tree_probability);
-    r.get(c, "city", "parked_car_probability", s.city.parked_car_probability);
-    const YAML::Node ro = root["route"];
-    r.keys(ro, "route",
-           {"speed_min_mps", "speed_max_mps", "max_lateral_accel_mps2", "max_long_accel_mps2",
-            "turn_probability", "turn_radius_m", "lane_offset_m", "rate_hz", "pitch_amplitude_deg",
-            "roll_amplitude_deg", "roll_per_lateral_accel_deg", "pitch_per_long_accel_deg"});
-    r.get(ro, "route", "speed_min_mps", s.route.speed_min_mps);
-    r.get(ro, "route", "speed_max_mps", s.route.speed_max_mps);
-    r.get(ro, "route", "max_lateral_accel_mps2", s.route.max_lateral_accel_mps2);
-    r.get(ro, "route", "max_long_accel_mps2", s.route.max_long_accel_mps2);
-    r.get(ro, "route", "turn_probability", s.route.turn_probability);
-    r.get(ro, "route", "turn_radius_m", s.route.turn_radius_m);
-    r.get(ro, "route", "lane_offset_m", s.route.lane_offset_m);
-    r.get(ro, "route", "rate_hz", s.route.rate_hz);
-    r.get(ro, "route", "pitch_amplitude_deg", s.route.pitch_amplitude_deg);
-    r.get(ro, "route", "roll_amplitude_deg", s.route.roll_amplitude_deg);
-    r.get(ro, "route", "roll_per_lateral_accel_deg", s.route.roll_per_lateral_accel_deg);
-    r.get(ro, "route", "pitch_per_long_accel_deg", s.route.pitch_per_long_accel_deg);
-    const YAML::Node cam = root["camera"];
-    r.keys(cam, "camera", {"fu", "fv", "cu", "cv", "baseline_m", "width", "height"});
-    r.get(cam, "camera", "fu", s.camera.fu);
-    r.get(cam, "camera", "fv", s.camera.fv);
-    r.get(cam, "camera", "cu", s.camera.cu);
-    r.get(cam, "camera", "cv", s.camera.cv);
-    r.get(cam, "camera", "baseline_m", s.camera.baseline_m);
-    r.get(cam, "camera", "width", s.camera.width);
-    r.get(cam, "camera", "height", s.camera.height);
-    const YAML::Node q = root["render"];
-    r.keys(q, "render", {"antialias_threshold", "antialias_depth", "quality"});
-    r.get(q, "render", "antialias_threshold", s.quality.antialias_threshold);
-    r.get(q, "render", "antialias_depth", s.quality.antialias_depth);
-    r.get(q, "render", "quality", s.quality.quality);
-    const YAML::Node se = root["sensor"];
-    r.keys(se, "sensor",
-           {"full_well_e", "read_noise_e", "vignetting", "exposure_sigma", "exposure_target",
-            "motion_blur_px"});
-    r.get(se, "sensor", "full_well_e", s.sensor.full_well_e);
-    r.get(se, "sensor", "read_noise_e", s.sensor.read_noise_e);
-    r.get(se, "sensor", "vignetting", s.sensor.vignetting);
-    r.get(se, "sensor", "exposure_sigma", s.sensor.exposure_sigma);
-    r.get(se, "sensor", "exposure_target", s.sensor.exposure_target);
-    r.get(se, "sensor", "motion_blur_px", s.sensor.motion_blur_px);
-    const YAML::Node ce = root["calib_error"];
-    r.keys(ce, "calib_error", {"focal_scale", "cu_offset_px", "cv_offset_px", "baseline_scale"});
-    r.get(ce, "calib_error", "focal_scale", s.calib_error.focal_scale);
-    r.get(ce, "calib_error", "cu_offset_px", s.calib_error.cu_offset_px);
-    r.get(ce, "calib_error", "cv_offset_px", s.calib_error.cv_offset_px);
-    r.get(ce, "calib_error", "baseline_scale", s.calib_error.baseline_scale);
-  } catch (const YAML::Exception& e) {
-    return parseError(label + ": YAML: " + e.what());
-  }
-  SUNVO_RETURN_IF_ERROR(r.st);
-  if (auto st = s.validate(); !st.isOk()) return invalidArgument(label + ": " + st.message());
-  return s;
-}
-
-Expected<Scenario> loadScenario(const std::string& path) {
-  std::ifstream f(path);
-  if (!f) return notFound("cannot open scenario " + path);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return parseScenario(ss.str(), path);
-}
 
 Isometry3 bodyFromCamera0() {
   Isometry3 T = Isometry3::Identity();
@@ -288,44 +84,6 @@ FrameLighting computeLighting(const Eigen::Vector3d& sun_enu, const SkyOptions& 
   f.pov.ambient_rgb = 0.8 * f.exposure_scale * E_sky_rgb / kPi;
   f.sun_zenith_deg = zs * 180.0 / kPi;
   return f;
-}
-
-cv::Mat applySensor(const cv::Mat& bgr8, const SensorOptions& o, double gain, double fu, double cu,
-                    double cv_px, std::uint64_t noise_seed) {
-  cv::Mat lin(bgr8.size(), CV_32FC3);
-  float lut[256];
-  for (int i = 0; i < 256; ++i) lut[i] = static_cast<float>(srgbToLinear(i / 255.0));
-  for (int y = 0; y < bgr8.rows; ++y)
-    for (int x = 0; x < bgr8.cols; ++x) {
-      const cv::Vec3b p = bgr8.at<cv::Vec3b>(y, x);
-      lin.at<cv::Vec3f>(y, x) = cv::Vec3f(lut[p[0]], lut[p[1]], lut[p[2]]);
-    }
-  if (o.motion_blur_px >= 1.0) {
-    const int k = static_cast<int>(std::lround(o.motion_blur_px));
-    cv::blur(lin, lin, cv::Size(k, 1));
-  }
-  std::mt19937_64 rng(noise_seed);
-  std::normal_distribution<float> N01(0.0f, 1.0f);
-  cv::Mat out(bgr8.size(), CV_8UC3);
-  const double fw = o.full_well_e > 0 ? o.full_well_e : 8000.0;
-  for (int y = 0; y < bgr8.rows; ++y)
-    for (int x = 0; x < bgr8.cols; ++x) {
-      // Natural vignetting cos^4(angle off axis), applied with strength o.vignetting.
-      const double r2 = ((x - cu) * (x - cu) + (y - cv_px) * (y - cv_px)) / (fu * fu);
-      const double c4 = 1.0 / ((1.0 + r2) * (1.0 + r2));
-      const double v = gain * (1.0 - o.vignetting * (1.0 - c4));
-      cv::Vec3b& q = out.at<cv::Vec3b>(y, x);
-      const cv::Vec3f p = lin.at<cv::Vec3f>(y, x);
-      for (int c = 0; c < 3; ++c) {
-        // Electrons e = fw * signal; shot noise sqrt(e), read noise sigma_r (Gaussian approx.).
-        const double e = fw * std::min(static_cast<double>(p[c]) * v, 1.2);
-        const double sigma =
-            std::sqrt((o.full_well_e > 0 ? e : 0.0) + o.read_noise_e * o.read_noise_e);
-        const double s = (e + sigma * static_cast<double>(N01(rng))) / fw;
-        q[c] = static_cast<unsigned char>(std::lround(255.0 * linearToSrgb(s)));
-      }
-    }
-  return out;
 }
 
 Status writeKittiCalibration(const std::string& dir, const StereoCamera& cam,
@@ -411,7 +169,8 @@ std::string kittiTimestamp(TimeNs t) {
 Expected<std::string> renderDrive(const Scenario& s, const std::string& out_root, int jobs,
                                   const std::function<void(const DriveProgress&)>& progress) {
   SUNVO_RETURN_IF_ERROR(s.validate());
-  const City city = generateCity(s.city, s.seed);
+  const DriveLook drive_look = drawDriveLook(s.style, s.city);
+  const City city = generateCity(drive_look.city, s.seed, drive_look.city_look);
   auto route = generateRoute(city, s.route, s.frames, s.seed);
   if (!route) return route.status();
   const std::string iso = formatUtcIso(s.start_utc);
@@ -443,6 +202,9 @@ Expected<std::string> renderDrive(const Scenario& s, const std::string& out_root
       body_csv = "frame,utc_ns,e,n,u,roll_rad,pitch_rad,yaw_rad,ve,vn,vu\n";
   std::vector<RenderJob> render_jobs;
   std::vector<double> gains;
+  std::vector<SensorOptions> frame_sensor;  // the look of each frame's camera
+  FrameLook look;
+  int look_period = -1;
   std::mt19937_64 exp_rng(s.seed * 7919 + 17);
   std::normal_distribution<double> N01(0.0, 1.0);
   double log_gain = 0.0;
@@ -462,14 +224,27 @@ Expected<std::string> renderDrive(const Scenario& s, const std::string& out_root
     const Isometry3 T_enu_c0 = vs.T_enu_b * T_b_c0;
     const Isometry3 T_enu_c1 = T_enu_c0 * T_c0_c1;
     if (k == 0) T_enu_c0_first = T_enu_c0;
-    FrameLighting fl = computeLighting(sp->sun_enu, s.sky, s.sensor.exposure_target);
+    const int period = s.style.frames_per_look > 0 ? k / s.style.frames_per_look : 0;
+    if (k == 0 || period != look_period) {
+      look = drawFrameLook(s.style, period, s.sky, s.sensor);
+      look_period = period;
+    }
+    frame_sensor.push_back(look.sensor);
+    FrameLighting fl = computeLighting(sp->sun_enu, look.sky, look.sensor.exposure_target);
+    fl.pov.sun_rgb = fl.pov.sun_rgb.cwiseProduct(look.sun_tint);
+    fl.pov.ambient_rgb = look.ambient_scale * fl.pov.ambient_rgb.cwiseProduct(look.sky_tint);
+    fl.pov.materials = look.materials;
     char name[64];
     std::snprintf(name, sizeof name, "sky_%06d.hdr", k);
     fl.pov.sky_image = name;
-    const PerezSky sky(sp->sun_enu, s.sky);
-    const cv::Mat sky_img =
-        sky.equirectangular(s.sky_image_width, s.sky_image_width / 2, fl.exposure_scale,
-                            Eigen::Vector3d(1500, 1500, 1500));
+    const PerezSky sky(sp->sun_enu, look.sky);
+    cv::Mat sky_img = sky.equirectangular(s.sky_image_width, s.sky_image_width / 2,
+                                          fl.exposure_scale, Eigen::Vector3d(1500, 1500, 1500));
+    if (s.style.seed != 0) {  // BGR channel order
+      cv::multiply(sky_img, cv::Scalar(look.sky_tint.z(), look.sky_tint.y(), look.sky_tint.x()),
+                   sky_img);
+      addSunGlow(sky_img, sp->sun_enu, look, look.sensor.exposure_target);
+    }
     if (!cv::imwrite(pov_dir + "/" + name, sky_img))
       return ioError("cannot write sky image " + std::string(name));
     std::snprintf(name, sizeof name, "frame_%06d.pov", k);
@@ -548,8 +323,9 @@ Expected<std::string> renderDrive(const Scenario& s, const std::string& out_root
             post = ioError("cannot read povray output " + raw);
           } else {
             const cv::Mat sens = applySensor(
-                img, s.sensor, gains[static_cast<std::size_t>(k)], s.camera.fu, s.camera.cu,
-                s.camera.cv, s.seed * 1000003ULL + static_cast<std::uint64_t>(2 * k + c));
+                img, frame_sensor[static_cast<std::size_t>(k)], gains[static_cast<std::size_t>(k)],
+                s.camera.fu, s.camera.cu, s.camera.cv,
+                s.seed * 1000003ULL + static_cast<std::uint64_t>(2 * k + c));
             cv::Mat gray;
             cv::cvtColor(sens, gray, cv::COLOR_BGR2GRAY);
             char fn[32];

@@ -57,6 +57,14 @@ std::string povSceneBody(const Scene& scene) {
       case Primitive::Kind::kSphere:
         s += "sphere { " + povVector(p.a) + ", " + num(p.radius) + " " + tex + " }\n";
         break;
+      case Primitive::Kind::kCone:
+        s += "cone { " + povVector(p.a) + ", " + num(p.radius) + ", " + povVector(p.b) + ", 0 " +
+             tex + " }\n";
+        break;
+      case Primitive::Kind::kEllipsoid:  // unit sphere scaled by the semi-axes, then moved
+        s += "sphere { <0,0,0>, 1 " + tex + " scale " + povVector(p.b) + " translate " +
+             povVector(p.a) + " }\n";
+        break;
     }
   }
   return s;
@@ -93,6 +101,7 @@ std::string povFrame(const std::vector<StereoCamera>& cams, const std::vector<Is
   } else {
     s += "sky_sphere { pigment { " + col(L.flat_sky_rgb) + " } }\n";
   }
+  s += L.materials;
   if (!include_file.empty()) {
     s += "#include \"" + include_file + "\"\n";
   } else if (inline_scene != nullptr) {

@@ -46,6 +46,99 @@ const char* kAsphalt =
     "pigment { granite scale 0.15 color_map { [0 rgb 0.10] [0.5 rgb 0.17] [1 rgb 0.23] } } "
     "normal { granite 0.15 scale 0.03 }";
 
+// Styled crowns: a sphere, an ellipsoid (taller or flatter), a cone (conifer) or a cluster of
+// three spheres, all of about the classic crown's size (radius rc, centred at c).
+template <typename Uni>
+void addCrown(Scene& sc, CityLook::Tree shape, const Eigen::Vector3d& c, double rc, Uni& uni) {
+  switch (shape) {
+    case CityLook::Tree::kSphere:
+      sc.primitives.push_back(
+          {Primitive::Kind::kSphere, c, Eigen::Vector3d::Zero(), rc, "T_crown"});
+      break;
+    case CityLook::Tree::kEllipsoid: {
+      const double flat = uni(0.6, 1.6);  // vertical over horizontal semi-axis
+      sc.primitives.push_back(
+          {Primitive::Kind::kEllipsoid, c, {rc, rc, rc * flat}, 0.0, "T_crown"});
+      break;
+    }
+    case CityLook::Tree::kCone:
+      sc.primitives.push_back({Primitive::Kind::kCone, c - Eigen::Vector3d(0, 0, 1.2 * rc),
+                               c + Eigen::Vector3d(0, 0, 1.6 * rc), 0.9 * rc, "T_crown"});
+      break;
+    case CityLook::Tree::kCluster:
+      for (int i = 0; i < 3; ++i) {
+        const double ang = 2.0944 * i + uni(-0.5, 0.5);
+        const Eigen::Vector3d d(0.5 * rc * std::cos(ang), 0.5 * rc * std::sin(ang),
+                                uni(-0.3, 0.4) * rc);
+        sc.primitives.push_back(
+            {Primitive::Kind::kSphere, c + d, Eigen::Vector3d::Zero(), 0.7 * rc, "T_crown"});
+      }
+      break;
+  }
+}
+
+// Hedges along the facades and clutter near the curb on one sidewalk (curb from a along t,
+// street on the side `out`, length L).
+template <typename Uni>
+void addSidewalkExtras(Scene& sc, const CityLook& look, const Eigen::Vector2d& a,
+                       const Eigen::Vector2d& t, const Eigen::Vector2d& out, double L,
+                       double sidewalk_m, Uni& uni) {
+  for (double s = 3.0; s < L - 9.0; s += 12.0) {
+    if (uni(0.0, 1.0) < look.hedge_probability) {
+      const double len = uni(3.0, 8.0), depth = uni(0.6, 1.0), h = uni(0.6, 1.5);
+      const Eigen::Vector2d p = a + t * s - out * (sidewalk_m - depth);
+      const Eigen::Vector2d q = p + t * len - out * depth;
+      sc.primitives.push_back(box({std::min(p.x(), q.x()), std::min(p.y(), q.y()), 0.1},
+                                  {std::max(p.x(), q.x()), std::max(p.y(), q.y()), h}, "T_hedge"));
+    }
+    if (uni(0.0, 1.0) < look.clutter_probability) {
+      const Eigen::Vector2d p = a + t * (s + uni(1.0, 8.0)) - out * 0.6;
+      if (look.clutter == CityLook::Clutter::kBins) {
+        const double r = uni(0.25, 0.4), h = uni(0.8, 1.2);
+        sc.primitives.push_back(
+            {Primitive::Kind::kCylinder, {p.x(), p.y(), 0.0}, {p.x(), p.y(), h}, r, "T_clutter"});
+      } else {  // a row of bollards and a bench behind them
+        for (int i = 0; i < 3; ++i) {
+          const Eigen::Vector2d b = p + t * (1.4 * i);
+          sc.primitives.push_back({Primitive::Kind::kCylinder,
+                                   {b.x(), b.y(), 0.0},
+                                   {b.x(), b.y(), 0.9},
+                                   0.1,
+                                   "T_clutter"});
+        }
+        const Eigen::Vector2d q = p - out * 1.0, r = q + t * 1.8 - out * 0.5;
+        sc.primitives.push_back(box({std::min(q.x(), r.x()), std::min(q.y(), r.y()), 0.0},
+                                    {std::max(q.x(), r.x()), std::max(q.y(), r.y()), 0.45},
+                                    "T_clutter"));
+      }
+    }
+  }
+}
+
+// A styled parked car: a sedan (body and glass cabin, as the classic one) or a van (one tall
+// body with a glass band); its paint is one of the declared T_car textures.
+void addStyledCar(Scene& sc, CityLook::Car shape, const Eigen::Vector2d& c,
+                  const Eigen::Vector2d& half, const Eigen::Vector2d& half_cab,
+                  std::mt19937_64& rng) {
+  const std::string paint = "T_car" + std::to_string(rng() % kStyleCars);
+  if (shape == CityLook::Car::kSedan) {
+    sc.primitives.push_back(box({c.x() - half.x(), c.y() - half.y(), 0.25},
+                                {c.x() + half.x(), c.y() + half.y(), 0.95}, paint));
+    sc.primitives.push_back(box({c.x() - half_cab.x(), c.y() - half_cab.y(), 0.95},
+                                {c.x() + half_cab.x(), c.y() + half_cab.y(), 1.45}, "T_glass"));
+  } else {
+    sc.primitives.push_back(box({c.x() - half.x(), c.y() - half.y(), 0.25},
+                                {c.x() + half.x(), c.y() + half.y(), 1.5}, paint));
+    sc.primitives.push_back(box({c.x() - half.x() - 0.01, c.y() - half.y() - 0.01, 1.5},
+                                {c.x() + half.x() + 0.01, c.y() + half.y() + 0.01, 2.0},
+                                "T_glass"));
+    sc.primitives.push_back(box({c.x() - half.x(), c.y() - half.y(), 2.0},
+                                {c.x() + half.x(), c.y() + half.y(), 2.2}, paint));
+  }
+  sc.primitives.push_back(box({c.x() - half.x() + 0.4, c.y() - half.y() + 0.1, 0.0},
+                              {c.x() + half.x() - 0.4, c.y() + half.y() - 0.1, 0.25}, "T_tyre"));
+}
+
 }  // namespace
 
 Status CityOptions::validate() const {
@@ -71,7 +164,7 @@ Status CityOptions::validate() const {
   return Status::ok();
 }
 
-City generateCity(const CityOptions& o, std::uint64_t seed) {
+City generateCity(const CityOptions& o, std::uint64_t seed, const CityLook& look) {
   City city;
   city.options = o;
   city.pitch_m = o.block_size_m + o.street_width_m;
@@ -79,8 +172,8 @@ City generateCity(const CityOptions& o, std::uint64_t seed) {
   std::uniform_real_distribution<double> U(0.0, 1.0);
   auto uni = [&](double a, double b) { return a + (b - a) * U(rng); };
   Scene& sc = city.scene;
-  sc.declarations = kDeclarations;
-  sc.ground_texture = kAsphalt;
+  sc.declarations = look.styled ? "" : kDeclarations;
+  sc.ground_texture = look.styled ? "T_asphalt" : kAsphalt;
   const double P = city.pitch_m, hw = 0.5 * o.street_width_m, B = o.block_size_m;
   static constexpr std::array<std::array<double, 3>, 8> kWall = {{{0.62, 0.55, 0.46},
                                                                   {0.55, 0.55, 0.55},
@@ -107,6 +200,12 @@ City generateCity(const CityOptions& o, std::uint64_t seed) {
           double w = uni(o.min_lot_m, o.max_lot_m);
           if (x1 - sw - (x + w) < o.min_lot_m) w = x1 - sw - x;
           const double h = uni(o.min_height_m, o.max_height_m);
+          if (look.styled) {
+            const std::string tex = "F" + std::to_string(rng() % kStyleFacades);
+            sc.primitives.push_back(box({x, ya, 0.0}, {x + w, yb, h}, tex));
+            x += w;
+            continue;
+          }
           const auto& c = kWall[static_cast<std::size_t>(rng() % kWall.size())];
           const double s = uni(0.85, 1.1);
           char tex[512];
@@ -168,15 +267,24 @@ City generateCity(const CityOptions& o, std::uint64_t seed) {
                                    {p.x(), p.y(), ht + rc},
                                    0.14,
                                    "T_trunk"});
-          sc.primitives.push_back(
-              {Primitive::Kind::kSphere, {p.x(), p.y(), ht + rc}, {}, rc, "T_crown"});
+          if (look.styled) {
+            addCrown(sc, look.tree, {p.x(), p.y(), ht + rc}, rc, uni);
+          } else {
+            sc.primitives.push_back(
+                {Primitive::Kind::kSphere, {p.x(), p.y(), ht + rc}, {}, rc, "T_crown"});
+          }
         }
+        if (look.styled) addSidewalkExtras(sc, look, a, t, out, L, o.sidewalk_width_m, uni);
         // Parked cars on the curb lane, not within 12 m of an intersection.
         for (double s = 12.0; s < L - 12.0; s += 7.0) {
           if (U(rng) >= o.parked_car_probability) continue;
           const Eigen::Vector2d c = a + t * (s + uni(-0.5, 0.5)) + out * 1.1;
           const Eigen::Vector2d half = t.cwiseAbs() * 2.1 + out.cwiseAbs() * 0.9;
           const Eigen::Vector2d half_cab = t.cwiseAbs() * 1.1 + out.cwiseAbs() * 0.8;
+          if (look.styled) {
+            addStyledCar(sc, look.car, c, half, half_cab, rng);
+            continue;
+          }
           const auto col = rgb(uni(0.05, 0.8), uni(0.05, 0.8), uni(0.05, 0.8));
           const std::string tex = "pigment { " + col + " } finish { specular 0.3 }";
           sc.primitives.push_back(box({c.x() - half.x(), c.y() - half.y(), 0.25},

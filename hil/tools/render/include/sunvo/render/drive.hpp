@@ -24,20 +24,10 @@
 #include "sunvo/render/perez_sky.hpp"
 #include "sunvo/render/pov.hpp"
 #include "sunvo/render/scene.hpp"
+#include "sunvo/render/sensor.hpp"
+#include "sunvo/render/style.hpp"
 
 namespace sunvo::render {
-
-struct SensorOptions {
-  double full_well_e =
-      8000.0;  // electrons at saturation (shot noise), [100, 1e6]; 0 = no shot noise
-  double read_noise_e = 12.0;    // read noise std, electrons, [0, 1000]
-  double vignetting = 0.3;       // 0 = none; fraction of the cos^4 fall-off applied, [0, 1]
-  double exposure_sigma = 0.02;  // per-frame log-gain innovation (AR(1), 0.9), [0, 0.5]
-  double exposure_target =
-      0.3;  // linear value of an albedo-0.25 patch under E_sky + E_sun max(cos z_s, 0.5), (0, 1]
-  double motion_blur_px = 0.0;  // horizontal box blur length, px, [0, 20]; 0 = off
-  Status validate() const;
-};
 
 // Written calibration = true calibration perturbed by these (the images use the true one).
 struct CalibErrorOptions {
@@ -64,6 +54,7 @@ struct Scenario {
   StereoCamera camera{721.5377, 721.5377, 609.5593, 172.854, 0.537, 1242, 375};
   RenderQuality quality;
   SensorOptions sensor;
+  StyleOptions style;  // domain randomisation of the look (style.hpp); seed 0 = classic
   CalibErrorOptions calib_error;
   Status validate() const;
 };
@@ -88,10 +79,6 @@ struct FrameLighting {
 };
 FrameLighting computeLighting(const Eigen::Vector3d& sun_enu, const SkyOptions& sky,
                               double exposure_target);
-
-// Applies exposure gain, vignetting, motion blur and noise to a BGR8 image (sRGB-encoded).
-cv::Mat applySensor(const cv::Mat& bgr8, const SensorOptions& o, double gain, double fu, double cu,
-                    double cv_px, std::uint64_t noise_seed);
 
 // Writes the KITTI calibration files into date_dir.
 Status writeKittiCalibration(const std::string& date_dir, const StereoCamera& cam,

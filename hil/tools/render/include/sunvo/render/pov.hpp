@@ -37,6 +37,7 @@ struct Lighting {
   Eigen::Vector3d ambient_rgb = Eigen::Vector3d::Constant(0.2);  // ambient_light (linear)
   std::string sky_image;  // HDR file for the sky_sphere (map_type 1); empty: flat sky colour
   Eigen::Vector3d flat_sky_rgb = Eigen::Vector3d(0.5, 0.6, 0.8);
+  std::string materials;  // POV text written before the scene: a styled frame's textures, fog
 };
 
 // The scene part (declarations, ground plane and primitives) as POV-Ray text.

@@ -14,11 +14,13 @@
 namespace sunvo::render {
 
 struct Primitive {
-  enum class Kind { kBox, kCylinder, kSphere };
+  enum class Kind { kBox, kCylinder, kSphere, kCone, kEllipsoid };
   Kind kind = Kind::kBox;
-  Eigen::Vector3d a = Eigen::Vector3d::Zero();  // box: min corner; cylinder: base; sphere: centre
-  Eigen::Vector3d b = Eigen::Vector3d::Zero();  // box: max corner; cylinder: top
-  double radius = 0.0;                          // cylinder, sphere
+  // box: min corner; cylinder, cone: base centre; sphere, ellipsoid: centre
+  Eigen::Vector3d a = Eigen::Vector3d::Zero();
+  // box: max corner; cylinder: top centre; cone: apex; ellipsoid: semi-axes along e, n, u
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();
+  double radius = 0.0;  // cylinder, sphere; cone: base radius
   std::string texture;  // POV-Ray texture body (inside texture { }) or a declared name
 };
 
@@ -51,7 +53,23 @@ struct City {
   // Street centre lines: x = i * pitch_m (i = 0..blocks_x), y = j * pitch_m (j = 0..blocks_y).
 };
 
-City generateCity(const CityOptions& options, std::uint64_t seed);
+// What a style (style.hpp) changes in the city's geometry. styled = false: the classic city,
+// whose fixed materials are in Scene::declarations. styled = true: every primitive names a
+// texture that each frame declares (style.hpp, FrameLook::materials): F0..F7 (facades with
+// their windows), T_asphalt, T_sidewalk, T_sidewalk2, T_mark, T_pole, T_trunk, T_crown, T_hedge,
+// T_glass, T_car0..T_car5, T_tyre, T_clutter.
+struct CityLook {
+  bool styled = false;
+  enum class Tree { kSphere, kEllipsoid, kCone, kCluster } tree = Tree::kSphere;
+  enum class Car { kSedan, kVan } car = Car::kSedan;
+  enum class Clutter { kBins, kBollards } clutter = Clutter::kBins;
+  double hedge_probability = 0.0;    // hedge along a facade per 12 m sidewalk slot, [0, 1]
+  double clutter_probability = 0.0;  // bins / bollards per 12 m sidewalk slot, [0, 1]
+};
+inline constexpr int kStyleFacades = 8;  // F0..F7
+inline constexpr int kStyleCars = 6;     // T_car0..T_car5
+
+City generateCity(const CityOptions& options, std::uint64_t seed, const CityLook& look = {});
 
 struct RouteOptions {
   double speed_min_mps = 8.0;               // cruise speed range, m/s, [1, 40]
