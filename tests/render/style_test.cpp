@@ -124,6 +124,32 @@ TEST(Style, SunGlowBrightensTheSkyAroundTheSunOnly) {
   EXPECT_EQ(cv::countNonZero(plain.reshape(1) != 0.1f), 0);
 }
 
+TEST(Style, SkyKindsRemoveTheAzimuthOrAddClouds) {
+  cv::Mat sky(64, 128, CV_32FC3);
+  for (int i = 0; i < 64; ++i)
+    for (int j = 0; j < 128; ++j) sky.at<cv::Vec3f>(i, j) = cv::Vec3f::all(0.1f + 0.005f * j);
+  FrameLook look;
+  cv::Mat perez = sky.clone();
+  styleSky(perez, look);
+  EXPECT_EQ(cv::norm(perez, sky, cv::NORM_INF), 0.0);
+  look.sky_kind = FrameLook::Sky::kAzimuthFree;
+  cv::Mat flat = sky.clone();
+  styleSky(flat, look);
+  EXPECT_NEAR(flat.at<cv::Vec3f>(10, 0)[0], flat.at<cv::Vec3f>(10, 127)[0], 1e-6f);
+  EXPECT_NEAR(cv::mean(flat)[0], cv::mean(sky)[0], 1e-6);
+  look.sky_kind = FrameLook::Sky::kClouds;
+  look.cloud_cover = 0.5;
+  look.cloud_seed = 9;
+  cv::Mat a = sky.clone(), b = sky.clone();
+  styleSky(a, look);
+  styleSky(b, look);
+  EXPECT_EQ(cv::norm(a, b, cv::NORM_INF), 0.0);  // deterministic for the seed
+  const cv::Mat diff = a != sky;
+  const double changed = cv::countNonZero(diff.reshape(1)) / (3.0 * 64 * 128);
+  EXPECT_GT(changed, 0.1);  // some of the upper half is cloud
+  EXPECT_LT(changed, 0.5);  // never below the horizon
+}
+
 TEST(Style, AStyledFrameRendersThroughPovRay) {
   for (const char* set : {"train", "heldout"}) {
     const StyleOptions style{11, set, 1};

@@ -243,6 +243,7 @@ Expected<std::string> renderDrive(const Scenario& s, const std::string& out_root
     if (s.style.seed != 0) {  // BGR channel order
       cv::multiply(sky_img, cv::Scalar(look.sky_tint.z(), look.sky_tint.y(), look.sky_tint.x()),
                    sky_img);
+      styleSky(sky_img, look);
       addSunGlow(sky_img, sp->sun_enu, look, look.sensor.exposure_target);
     }
     if (!cv::imwrite(pov_dir + "/" + name, sky_img))

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 #include <random>
 
 namespace sunvo::render {
@@ -265,6 +267,14 @@ FrameLook drawFrameLook(const StyleOptions& style, int period, const SkyOptions&
   s.read_noise_e = d.uni(2, 30);
   s.motion_blur_px = d.chance(0.5) ? 0.0 : d.uni(1.0, 3.0);
   s.defocus_sigma_px = d.chance(0.5) ? 0.0 : d.uni(0.3, 1.2);
+  const double sky_draw = d.uni(0, 1);
+  if (sky_draw < 0.2) {
+    f.sky_kind = FrameLook::Sky::kAzimuthFree;
+  } else if (sky_draw < 0.4) {
+    f.sky_kind = FrameLook::Sky::kClouds;
+    f.cloud_cover = d.uni(0.15, 0.7);
+    f.cloud_seed = static_cast<std::uint64_t>(d.uni(0, 1) * 4294967296.0);
+  }
   if (d.chance(0.7)) {
     f.glow_level = d.uni(0.5, 4.0);
     f.glow_width_deg = d.uni(1.5, 8.0);
@@ -272,6 +282,32 @@ FrameLook drawFrameLook(const StyleOptions& style, int period, const SkyOptions&
   const double fog_level = d.chance(0.5) ? s.exposure_target * d.uni(1.5, 3.0) : 0.0;
   f.materials = materials(d, fog_level, f.sky_tint);
   return f;
+}
+
+void styleSky(cv::Mat& sky_bgr, const FrameLook& look) {
+  if (look.sky_kind == FrameLook::Sky::kAzimuthFree) {
+    for (int i = 0; i < sky_bgr.rows; ++i) {
+      const cv::Scalar m = cv::mean(sky_bgr.row(i));
+      sky_bgr.row(i).setTo(m);
+    }
+  } else if (look.sky_kind == FrameLook::Sky::kClouds) {
+    // Smooth noise: a coarse uniform random grid, bicubically enlarged; cloud where it falls
+    // below the cover quantile, with soft edges.
+    cv::Mat coarse(8, 16, CV_32F);
+    cv::RNG rng(look.cloud_seed);
+    rng.fill(coarse, cv::RNG::UNIFORM, 0.0, 1.0);
+    cv::Mat field;
+    cv::resize(coarse, field, sky_bgr.size(), 0, 0, cv::INTER_CUBIC);
+    const cv::Scalar mean = cv::mean(sky_bgr(cv::Rect(0, 0, sky_bgr.cols, sky_bgr.rows / 2)));
+    const float grey = static_cast<float>(0.9 * (mean[0] + mean[1] + mean[2]) / 3.0);
+    const float cover = static_cast<float>(look.cloud_cover);
+    for (int i = 0; i < sky_bgr.rows / 2; ++i)
+      for (int j = 0; j < sky_bgr.cols; ++j) {
+        const float a = std::clamp((cover - field.at<float>(i, j)) / 0.1f + 0.5f, 0.0f, 1.0f);
+        cv::Vec3f& p = sky_bgr.at<cv::Vec3f>(i, j);
+        for (int c = 0; c < 3; ++c) p[c] = (1.0f - a) * p[c] + a * grey;
+      }
+  }
 }
 
 void addSunGlow(cv::Mat& sky_bgr, const Eigen::Vector3d& sun_enu, const FrameLook& look,

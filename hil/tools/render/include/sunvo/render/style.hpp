@@ -55,6 +55,11 @@ struct FrameLook {
   // lens glare), level relative to the exposure target, exp(-angle / width) fall-off.
   double glow_level = 0.0;  // 0 = no disc, no aureole
   double glow_width_deg = 3.0;
+  // The sky image: the Perez sky as computed, or an azimuth-free one (each row its mean: the
+  // sky's brightness then says nothing of the sun's azimuth), or the Perez sky under clouds.
+  enum class Sky { kPerez, kAzimuthFree, kClouds } sky_kind = Sky::kPerez;
+  double cloud_cover = 0.0;      // kClouds: share of the sky under cloud, [0, 1]
+  std::uint64_t cloud_seed = 0;  // kClouds: the cloud pattern
 };
 
 // The drive's geometry look and its city sizes (heights, street width) for style seed.
@@ -69,6 +74,10 @@ DriveLook drawDriveLook(const StyleOptions& style, const CityOptions& base);
 // the base sky and sensor and unit tints. Deterministic for (seed, set, period).
 FrameLook drawFrameLook(const StyleOptions& style, int period, const SkyOptions& base_sky,
                         const SensorOptions& base_sensor);
+
+// Applies the look's sky kind to an equirectangular sky image (BGR, CV_32FC3): azimuth-free
+// rows or clouds (grey, about as bright as the sky's mean, smooth random shapes).
+void styleSky(cv::Mat& sky_bgr, const FrameLook& look);
 
 // Adds the look's sun disc and aureole to an equirectangular sky image (BGR, CV_32FC3, the
 // layout of PerezSky::equirectangular) for the sun direction sun_enu; `exposure_target` is
