@@ -36,7 +36,8 @@ if(EXISTS "${CMAKE_SOURCE_DIR}/config/rover.yaml")
   # its model card (sun.model), and a placeholder for the stereo calibration
   # (source.v4l2.calibration), a conffile that stops the program until the administrator puts
   # the pair's own calibration there; dpkg keeps that file on upgrades.
-  install(FILES config/sun_cnn.onnx config/sun_cnn.json DESTINATION share/sunvo)
+  install(FILES config/sun_cnn.onnx config/sun_cnn.json config/sun_cnn_gray.onnx config/sun_cnn_gray.json
+          DESTINATION share/sunvo)
   install(FILES config/debian/calib_cam_to_cam.txt DESTINATION /etc/sunvo)
   list(APPEND _sunvo_conffiles /etc/sunvo/calib_cam_to_cam.txt)
 endif()

@@ -1,14 +1,16 @@
 #!/usr/bin/env bash
-# Sun-CNN: renders the training and held-out drives (skipped when already rendered), writes the
-# manifest and the SHA-256 of the training data, trains with PyTorch (CPU) and exports
-# config/sun_cnn.onnx + config/sun_cnn.json + the parity reference.
+# Sun-CNN: renders the training, validation and test drives (skipped when already rendered),
+# writes the manifest and the SHA-256 of the training data, trains the colour and the grey
+# model with PyTorch (CPU) and exports config/sun_cnn{,_gray}.onnx + .json + parity references.
 #
 #   bash scripts/train_sun_cnn.sh                 # render what is missing, then train
 #   bash scripts/train_sun_cnn.sh --render-only   # only render (and write the manifest)
 #
 # Needs: the sunvo_render tool (built here if missing), povray, and python3-torch
 # (bash scripts/setup.sh --train). Renders go to $SUNVO_RENDERS (default /work/renders), one
-# folder per scenario: train_* (training, config/scenarios/train_*.yaml) and val_* (held out).
+# folder per scenario (config/scenarios/): train_* (training; styled, training looks), val_*
+# (validation: held-out places, times and looks; the sigma scale and validity threshold are
+# chosen on it) and test_* (held-out looks, reported only).
 set -euo pipefail
 ROOT="$(cd "$(dirname "$0")/.." && pwd)"
 BUILD="${SUNVO_BUILD:-$ROOT/build/release}"
@@ -44,6 +46,9 @@ done
   echo "train_sun_cnn: python3-torch missing: bash scripts/setup.sh --train" >&2
   exit 1
 }
-nice -n 10 "$PY" "$ROOT/estimator/suncnn/training/sun_cnn_train.py" \
-  --manifest "$RENDERS/sun_cnn_manifest.csv" --out-dir "$ROOT/config" \
-  --reference "$ROOT/tests/suncnn/data/sun_cnn_reference.txt"
+for model in colour gray; do
+  if [ "$model" = colour ]; then name=sun_cnn channels=3; else name=sun_cnn_gray channels=1; fi
+  (cd "$ROOT/estimator/suncnn/training" && nice -n 10 "$PY" sun_cnn_train.py \
+    --manifest "$RENDERS/sun_cnn_manifest.csv" --out-dir "$ROOT/config" --name "$name" \
+    --channels "$channels" --reference "$ROOT/tests/suncnn/data/${name}_reference.txt")
+done

@@ -26,6 +26,9 @@ Status SunCnnOptions::validate() const {
   if (!(input_height >= 16 && input_height <= 2048)) return range("input_height", "[16, 2048]");
   if (!(pixel_mean >= 0.0 && pixel_mean <= 1.0)) return range("pixel_mean", "[0, 1]");
   if (!(pixel_std > 0.0 && pixel_std <= 10.0)) return range("pixel_std", "(0, 10]");
+  if (input_channels != 1 && input_channels != 3) return range("input_channels", "{1, 3}");
+  if (!(ensemble_members >= 1 && ensemble_members <= 16))
+    return range("ensemble_members", "[1, 16]");
   if (!(mask_rows >= 2 && mask_rows <= 1024)) return range("mask_rows", "[2, 1024]");
   if (!(mask1_size >= 1 && mask1_size <= 1000000)) return range("mask1_size", "[1, 1e6]");
   if (!(mask2_size >= 1 && mask2_size <= 1000000)) return range("mask2_size", "[1, 1e6]");
@@ -76,8 +79,9 @@ Status SunCnnEstimator::finishInit() {
   net_.setPreferableBackend(cv::dnn::DNN_BACKEND_OPENCV);
   net_.setPreferableTarget(cv::dnn::DNN_TARGET_CPU);
   rng_.seed(o.seed);
-  small_.create(o.input_height, o.input_width, CV_8UC3);
-  const int blob_shape[] = {1, 3, o.input_height, o.input_width};
+  small3_.create(o.input_height, o.input_width, CV_8UC3);
+  small1_.create(o.input_height, o.input_width, CV_8UC1);
+  const int blob_shape[] = {1, o.input_channels, o.input_height, o.input_width};
   blob_.create(4, blob_shape, CV_32F);
   blob_.setTo(0.0f);
   mask1_.create(o.mask_rows, o.mask1_size, CV_32F);
@@ -93,13 +97,14 @@ Status SunCnnEstimator::finishInit() {
   } catch (const cv::Exception& e) {
     return invalidArgument(
         "suncnn: the model does not run with the shapes of suncnn.input_width/input_height/"
-        "mask_rows/mask1_size/mask2_size: " +
+        "input_channels/mask_rows/mask1_size/mask2_size: " +
         e.msg);
   }
-  if (out_.total() != static_cast<std::size_t>(o.mask_rows) * 2)
+  const std::size_t expected = static_cast<std::size_t>(o.ensemble_members * o.mask_rows) * 2;
+  if (out_.total() != expected)
     return invalidArgument(
         "suncnn: model output has " + std::to_string(out_.total()) +
-        " values, expected suncnn.mask_rows x 2 = " + std::to_string(o.mask_rows * 2));
+        " values, expected suncnn.ensemble_members x mask_rows x 2 = " + std::to_string(expected));
   ready_ = true;
   return Status::ok();
 }
@@ -138,7 +143,8 @@ Expected<sunfusion::ImageSunEstimate> SunCnnEstimator::estimate(
   const cv::Mat& img = input.color;
   const SunCnnOptions& o = options_;
   if (img.empty()) return invalidArgument("suncnn: empty image");
-  if (img.type() != CV_8UC3) return invalidArgument("suncnn: image must be CV_8UC3 (BGR)");
+  if (img.type() != CV_8UC3 && img.type() != CV_8UC1)
+    return invalidArgument("suncnn: image must be CV_8UC3 (BGR) or CV_8UC1 (grey)");
   if (input.camera.width > 0 && input.camera.height > 0 &&
       (img.cols != input.camera.width || img.rows != input.camera.height))
     return invalidArgument("suncnn: image " + std::to_string(img.cols) + "x" +
@@ -149,17 +155,30 @@ Expected<sunfusion::ImageSunEstimate> SunCnnEstimator::estimate(
     return invalidArgument("suncnn: image smaller than the network input " +
                            std::to_string(o.input_width) + "x" + std::to_string(o.input_height));
 
-  // Pre-processing exactly as in training: INTER_AREA resize, BGR planes, (v/255 - mean)/std.
-  cv::resize(img, small_, small_.size(), 0.0, 0.0, cv::INTER_AREA);
+  // Pre-processing exactly as in training: INTER_AREA resize, then the model's planes (BGR, or
+  // BT.601 luma 0.114 B + 0.587 G + 0.299 R), (v/255 - mean)/std.
+  const bool grey_in = img.type() == CV_8UC1;
+  cv::Mat& small = grey_in ? small1_ : small3_;
+  cv::resize(img, small, small.size(), 0.0, 0.0, cv::INTER_AREA);
   const float a = static_cast<float>(1.0 / (255.0 * o.pixel_std));
   const float b = static_cast<float>(-o.pixel_mean / o.pixel_std);
   const int plane = o.input_width * o.input_height;
   float* dst = blob_.ptr<float>();
   for (int y = 0; y < o.input_height; ++y) {
-    const unsigned char* src = small_.ptr<unsigned char>(y);
-    for (int x = 0; x < o.input_width; ++x)
-      for (int c = 0; c < 3; ++c)
-        dst[c * plane + y * o.input_width + x] = static_cast<float>(src[3 * x + c]) * a + b;
+    const unsigned char* src = small.ptr<unsigned char>(y);
+    for (int x = 0; x < o.input_width; ++x) {
+      const int at = y * o.input_width + x;
+      if (grey_in) {
+        const float v = static_cast<float>(src[x]) * a + b;
+        for (int c = 0; c < o.input_channels; ++c) dst[c * plane + at] = v;
+      } else if (o.input_channels == 3) {
+        for (int c = 0; c < 3; ++c)
+          dst[c * plane + at] = static_cast<float>(src[3 * x + c]) * a + b;
+      } else {
+        const float luma = 0.114f * src[3 * x] + 0.587f * src[3 * x + 1] + 0.299f * src[3 * x + 2];
+        dst[at] = luma * a + b;
+      }
+    }
   }
   fillMasks();
   try {
@@ -170,23 +189,28 @@ Expected<sunfusion::ImageSunEstimate> SunCnnEstimator::estimate(
   } catch (const cv::Exception& e) {
     return invalidArgument(std::string("suncnn: forward failed: ") + e.msg);
   }
-  if (outs_.empty() || outs_[0].total() != static_cast<std::size_t>(o.mask_rows) * 2)
+  const int M = o.ensemble_members, K = o.mask_rows;
+  if (outs_.empty() || outs_[0].total() != static_cast<std::size_t>(M * K) * 2)
     return invalidArgument("suncnn: unexpected model output size");
   const float* out = outs_[0].ptr<float>();
 
   SunCnnRaw raw;
-  raw.c = static_cast<double>(out[0]);
-  raw.s = static_cast<double>(out[1]);
   double sum_c = 0.0, sum_s = 0.0;
-  for (int r = 1; r <= o.mc_samples; ++r) {
-    const double c = static_cast<double>(out[2 * r]), s = static_cast<double>(out[2 * r + 1]);
-    const double n = std::hypot(c, s);
-    if (n > 1e-9 && std::isfinite(n)) {
-      sum_c += c / n;
-      sum_s += s / n;
-    }  // a zero or non-finite sample adds no direction: it lowers R_mc
+  for (int m = 0; m < M; ++m) {
+    const float* member = out + 2 * m * K;
+    raw.c += static_cast<double>(member[0]) / M;
+    raw.s += static_cast<double>(member[1]) / M;
+    for (int r = 1; r <= o.mc_samples; ++r) {
+      const double c = static_cast<double>(member[2 * r]);
+      const double s = static_cast<double>(member[2 * r + 1]);
+      const double n = std::hypot(c, s);
+      if (n > 1e-9 && std::isfinite(n)) {
+        sum_c += c / n;
+        sum_s += s / n;
+      }  // a zero or non-finite sample adds no direction: it lowers R_mc
+    }
   }
-  raw.r_mc = o.mc_samples > 0 ? std::hypot(sum_c, sum_s) / o.mc_samples : 1.0;
+  raw.r_mc = o.mc_samples > 0 ? std::hypot(sum_c, sum_s) / (M * o.mc_samples) : 1.0;
   const bool finite = std::isfinite(raw.c) && std::isfinite(raw.s);
   if (!finite) raw.c = raw.s = 0.0;  // no direction; sigma goes to its cap below
   raw.r_al = std::min(std::hypot(raw.c, raw.s), 1.0);

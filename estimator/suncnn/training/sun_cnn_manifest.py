@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Lists the rendered Sun-CNN frames with their labels and hashes the training data.
 
-For every completely rendered folder <renders>/{train,val}_*/ (one sunvo_render drive each,
+For every completely rendered folder <renders>/{train,val,test}_*/ (one sunvo_render drive each,
 marked by the file RENDERED) it reads
 gt/sun_cam0.csv and lists the colour images of both cameras (image_02, image_03: same
 orientation, so the same sun vector in the camera frame). Writes a CSV manifest
@@ -33,11 +33,12 @@ def main():
     rows = []
     train_images, train_labels = [], []
     for render_dir in sorted(glob.glob(os.path.join(a.renders, "train_*")) +
-                             glob.glob(os.path.join(a.renders, "val_*"))):
+                             glob.glob(os.path.join(a.renders, "val_*")) +
+                             glob.glob(os.path.join(a.renders, "test_*"))):
         if not os.path.isfile(os.path.join(render_dir, "RENDERED")):
             continue  # not (completely) rendered yet: train_sun_cnn.sh writes RENDERED last
         scenario = os.path.basename(render_dir)
-        split = "train" if scenario.startswith("train_") else "val"
+        split = scenario.split("_", 1)[0]  # train, val (choices) or test (reported only)
         d = drive_dir(render_dir)
         label_file = os.path.join(d, "gt", "sun_cam0.csv")
         with open(label_file) as f:
@@ -59,7 +60,7 @@ def main():
                 if split == "train":
                     train_images.append(img)
     if not rows:
-        raise SystemExit(f"sun_cnn_manifest: no train_*/val_* renders under {a.renders}")
+        raise SystemExit(f"sun_cnn_manifest: no train_*/val_*/test_* renders under {a.renders}")
     h = hashlib.sha256()
     for path in sorted(train_images) + sorted(train_labels):
         h.update(os.path.relpath(path, a.renders).encode() + b"\0")
@@ -72,7 +73,7 @@ def main():
     with open(a.out + ".sha256", "w") as f:
         f.write(h.hexdigest() + "\n")
     n_train = sum(r[0] == "train" for r in rows)
-    print(f"sun_cnn_manifest: {n_train} training, {len(rows) - n_train} held-out images; "
+    print(f"sun_cnn_manifest: {n_train} training, {len(rows) - n_train} validation/test images; "
           f"training data SHA-256 {h.hexdigest()}", file=sys.stderr)
 
 

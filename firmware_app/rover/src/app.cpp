@@ -165,7 +165,10 @@ Expected<std::unique_ptr<RoverApp>> RoverApp::create(const RoverConfig& config,
   if (!world) return world.status();
 
   runtime::FramePoolOptions frame_options = config.frames;
-  frame_options.color = needs_images;  // the capture thread copies left_color for the provider
+  // Colour slots only where the source delivers colour (KITTI replay); the V4L2 cameras are grey
+  // and the image providers then get the grey left image (every estimator accepts it).
+  const bool colour_frames = needs_images && config.source.type != SourceType::kV4l2;
+  frame_options.color = colour_frames;  // the capture thread copies left_color for the provider
   auto pool = runtime::FramePool::create(frame_options);
   if (!pool) return pool.status();
   impl->pool = std::move(*pool);
@@ -174,7 +177,7 @@ Expected<std::unique_ptr<RoverApp>> RoverApp::create(const RoverConfig& config,
   if (*provider && (*provider)->needsImages()) {
     runtime::FramePoolOptions so = config.frames;
     so.pool_depth = config.queues.sun_requests + 2;
-    so.color = true;
+    so.color = colour_frames;
     auto sp = runtime::FramePool::create(so);
     if (!sp) return sp.status();
     impl->sun_pool = std::move(*sp);

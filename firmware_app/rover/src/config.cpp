@@ -332,10 +332,6 @@ Status RoverConfig::validate() const {
   if (sun.provider == SunProviderType::kCsv && sun.csv.empty()) {
     return invalidArgument("sun.csv: empty, but sun.provider is csv");
   }
-  if (sunProviderNeedsColour(sun.provider) && source.type == SourceType::kV4l2) {
-    return invalidArgument("sun.provider: " + std::string(enumName(sun.provider)) +
-                           " needs the left colour image; source.type: v4l2 delivers gray");
-  }
   if (sun.provider == SunProviderType::kSunCnn && sun.model.empty()) {
     return invalidArgument("sun.model: empty, but sun.provider is sun_cnn");
   }

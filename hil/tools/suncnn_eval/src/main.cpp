@@ -1,14 +1,16 @@
 // sunvo_sun_cnn_eval: runs the Sun-CNN estimator over image sets with known sun and prints the
 // azimuth error (median, p90, share > 45 deg), the reported sigma and the time per call.
 //   sunvo_sun_cnn_eval --model config/sun_cnn.onnx [--threads 1] [--mc N] [--sigma-scale S]
+//       [--grey]                           feed every image as grey (CV_8UC1)
 //       [--drive <..._sync dir>]...        rendered/KITTI raw layout: image_02/data +
 //       gt/sun_cam0.csv
 //       [--odometry <frames dir> --sun-csv <file>]   KITTI odometry: grey image_0/*.png +
 //       frame,sx,sy,sz
 //       [--every N]                        every Nth frame of each drive
 //       [--csv out.csv]                    one line per image
-// Grey images are fed as BGR (Y, Y, Y). Exit status (firmware_app/cli): 0 ok, 2 a bad command
-// line or option value, 1 any other error.
+// The options come from the model's JSON beside it (when there is one), then --mc and
+// --sigma-scale. Images are fed as read (grey or BGR; the estimator takes either). Exit status
+// (firmware_app/cli): 0 ok, 2 a bad command line or option value, 1 any other error.
 #include <time.h>
 
 #include <chrono>
@@ -22,6 +24,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -90,17 +93,21 @@ int main(int argc, char** argv) {
   std::string model, odometry, sun_csv, csv_out;
   std::vector<std::string> drives;
   int threads = 1, every = 1;
-  sunvo::suncnn::SunCnnOptions options;
+  bool grey = false;
+  std::optional<int> mc;
+  std::optional<double> sigma_scale;
   CLI::App app{
       "Sun-CNN azimuth error, reported sigma and time per call on image sets with a known "
       "sun (rendered drives, KITTI odometry frames).",
       kProgram};
   app.add_option("--model", model, "the Sun-CNN ONNX model")->required();
   app.add_option("--threads", threads, "OpenCV threads")->check(CLI::Range(1, 1024));
-  app.add_option("--mc", options.mc_samples, "MC-dropout samples per image (0: none)")
+  app.add_option("--mc", mc, "MC-dropout samples per image (0: none; default: the model's JSON)")
       ->check(CLI::NonNegativeNumber);
-  app.add_option("--sigma-scale", options.sigma_scale, "calibration factor on the spread sigma")
+  app.add_option("--sigma-scale", sigma_scale,
+                 "calibration factor on the spread sigma (default: the model's JSON)")
       ->check(CLI::PositiveNumber);
+  app.add_flag("--grey", grey, "feed every image as grey (BT.601 luma)");
   app.add_option("--every", every, "every N-th frame of each set")->check(CLI::Range(1, 1000000));
   auto* drive = app.add_option("--drive", drives,
                                "a rendered or KITTI raw drive: image_02/data + gt/sun_cam0.csv "
@@ -117,6 +124,15 @@ int main(int argc, char** argv) {
                  kProgram);
     return sunvo::cli::kExitUsage;
   }
+  sunvo::suncnn::SunCnnOptions options;
+  const std::string json = sunvo::suncnn::modelJsonPath(model);
+  if (std::filesystem::exists(json)) {
+    auto o = sunvo::suncnn::loadSunCnnOptions(json);
+    if (!o) return sunvo::cli::fail(kProgram, o.status());
+    options = *o;
+  }
+  if (mc) options.mc_samples = *mc;
+  if (sigma_scale) options.sigma_scale = *sigma_scale;
   if (const Status st = options.validate(); !st.isOk()) {
     std::fprintf(stderr, "%s: %s\n", kProgram, st.toString().c_str());
     return sunvo::cli::kExitUsage;
@@ -186,7 +202,7 @@ int main(int argc, char** argv) {
     for (const Item& it : items) {
       cv::Mat img = cv::imread(it.image, cv::IMREAD_UNCHANGED);
       if (img.empty()) return sunvo::cli::fail(kProgram, "cannot read " + it.image);
-      if (img.channels() == 1) cv::cvtColor(img, img, cv::COLOR_GRAY2BGR);
+      if (grey && img.channels() == 3) cv::cvtColor(img, img, cv::COLOR_BGR2GRAY);
       sunvo::sunfusion::ImageSunInput in;
       in.color = img;
       const double cpu0 = threadCpuMs();

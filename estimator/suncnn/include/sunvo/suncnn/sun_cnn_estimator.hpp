@@ -1,26 +1,31 @@
 #pragma once
-// Sun-CNN: the sun's azimuth in the camera x-z plane from one colour image, with a per-image
-// uncertainty from Monte-Carlo dropout (after Ma, Kelly et al.'s Sun-CNN and Peretroukhin's
-// Sun-BCNN). The network is trained by estimator/suncnn/training/sun_cnn_train.py and shipped as
-// config/sun_cnn.onnx (+ sun_cnn.json, whose numbers the defaults below repeat).
+// Sun-CNN: the sun's azimuth in the camera x-z plane from one image, with a per-image
+// uncertainty from a deep ensemble and Monte-Carlo dropout (after Ma, Kelly et al.'s Sun-CNN and
+// Peretroukhin's Sun-BCNN). The networks are trained by estimator/suncnn/training/ on
+// domain-randomised renders and shipped as config/sun_cnn.onnx (colour) and
+// config/sun_cnn_gray.onnx (grey cameras), each with a JSON whose numbers the defaults repeat.
 //
 // The ONNX graph has three inputs and one output:
-//   image [1, 3, H, W]  BGR, (pixel / 255 - pixel_mean) / pixel_std, resized with INTER_AREA
+//   image [1, C, H, W]  BGR (C = 3) or grey (C = 1), (pixel / 255 - pixel_mean) / pixel_std,
+//                       resized with INTER_AREA (grey from colour: BT.601 luma after the resize)
 //   mask1 [K, F], mask2 [K, D]  inverted-dropout masks of the two fully connected layers
 //                              (entries 0 or 1 / (1 - p); a row of ones = dropout off)
-//   azimuth_cs [K, 2]           row k: (c, s) ~ (cos az, sin az), az = atan2(sun_x, sun_z)
-// The convolutional trunk runs once, the head K times (one row per mask pair), so N MC samples
-// cost one forward pass. This class draws the masks itself (seeded, reproducible): row 0 is all
-// ones (the deterministic answer), rows 1..N are dropout samples, the rest are unused.
+//   azimuth_cs [M K, 2]         row m K + k: member m's answer under mask row k,
+//                               (c, s) ~ (cos az, sin az), az = atan2(sun_x, sun_z)
+// Each member's trunk runs once, its head K times (one row per mask pair), so N MC samples per
+// member cost one forward pass. This class draws the masks itself (seeded, reproducible): row 0
+// is all ones (the deterministic answer), rows 1..N are dropout samples, the rest are unused.
 //
-// Uncertainty. Two mean resultant lengths in [0, 1], turned into circular standard deviations
-// sqrt(-2 ln R) and added in quadrature:
-//   R_mc = |mean of the N unit sample directions|  (model uncertainty, MC dropout spread)
-//   R_al = |deterministic output (c, s)|            (data ambiguity: the net is trained with the
-//          squared chord loss, whose minimiser is E[(cos az, sin az) | image], so an image with
-//          no sun cue -- black, flat, noise -- is answered with a short vector)
+// Answer and uncertainty. v = the mean of the M members' deterministic outputs; az = atan2(v).
+// Two mean resultant lengths in [0, 1], turned into circular standard deviations sqrt(-2 ln R)
+// and added in quadrature:
+//   R_mc = |mean of the M N unit sample directions|  (model uncertainty: members that disagree
+//          and dropout spread; the out-of-distribution signal)
+//   R_al = |v|  (data ambiguity: each net is trained with the squared chord loss, whose
+//          minimiser is E[(cos az, sin az) | image], so an image with no sun cue is answered
+//          with a short vector; members that disagree shorten the mean as well)
 //   sigma = clamp(sigma_scale * sqrt(-2 ln R_mc - 2 ln R_al), sigma_min_rad, sigma_max_rad)
-// sigma_scale is fitted on held-out renders (median |error| / sigma = 0.674, as for a Gaussian).
+// sigma_scale and max_valid_sigma_rad are chosen on the validation renders (held-out styles).
 //
 // The library opens no file but the model, and only when init() is given a path.
 
@@ -41,6 +46,8 @@ struct SunCnnOptions {
   int input_height = 64;        // network input height, px, must match the model, [16, 2048]
   double pixel_mean = 0.5;      // input normalisation (pixel / 255 - mean) / std, [0, 1]
   double pixel_std = 0.25;      // (0, 10]
+  int input_channels = 3;       // 3: BGR model, 1: grey model, must match the model, {1, 3}
+  int ensemble_members = 3;     // M, members in the model's output, must match, [1, 16]
   int mask_rows = 32;           // K, rows of the exported head, must match the model, [2, 1024]
   int mask1_size = 768;         // F, features into the first FC layer, must match, [1, 1e6]
   int mask2_size = 128;         // D, hidden units into the second FC layer, must match, [1, 1e6]
@@ -58,6 +65,14 @@ struct SunCnnOptions {
   std::uint64_t seed = 1;            // RNG of the dropout masks
   Status validate() const;           // names the bad key ("suncnn.mc_samples ...")
 };
+
+// The JSON the training script writes beside a model (<model>.json): the input size and
+// channels, ensemble members, mask sizes, dropout, sigma_scale and max_valid_sigma_rad, over
+// `base` (keys it lacks keep base's values). Errors name the file and the key.
+Expected<SunCnnOptions> loadSunCnnOptions(const std::string& json_path,
+                                          const SunCnnOptions& base = {});
+// "dir/name.onnx" -> "dir/name.json".
+std::string modelJsonPath(const std::string& model_path);
 
 // The raw network answer for one image, before the uncertainty is turned into a measurement.
 struct SunCnnRaw {
@@ -79,15 +94,18 @@ class SunCnnEstimator : public sunfusion::ImageSunEstimator {
   Status init(const SunCnnOptions& options, const std::vector<unsigned char>& model_bytes);
 
   const char* name() const override { return "sun_cnn"; }
+  bool acceptsGray() const override { return true; }
 
-  // Azimuth-only estimate: sun_c = (sin az, 0, cos az), sigma from the MC spread (see above).
+  // Azimuth-only estimate: sun_c = (sin az, 0, cos az), sigma from the spread (see above).
   // zenith_deg is 90 (the vector lies in the x-z plane), confidence = R_mc * R_al.
-  // Errors: not initialised; empty image or not CV_8UC3; image size != camera size (when the
+  // The image may be BGR (CV_8UC3) or grey (CV_8UC1), whatever the model's channels: a grey
+  // image feeds a colour model as (Y, Y, Y), a colour image a grey model as its BT.601 luma.
+  // Errors: not initialised; empty image or another type; image size != camera size (when the
   // camera's size is set); image smaller than the network input.
   Expected<sunfusion::ImageSunEstimate> estimate(const sunfusion::ImageSunInput& input) override;
 
-  // The network alone on a prepared input blob [1, 3, H, W] (CV_32F) and masks [K, F], [K, D]:
-  // the [K, 2] output. For the parity test against PyTorch.
+  // The network alone on a prepared input blob [1, C, H, W] (CV_32F) and masks [K, F], [K, D]:
+  // the [M K, 2] output. For the parity test against PyTorch.
   Expected<cv::Mat> forwardRaw(const cv::Mat& blob, const cv::Mat& mask1, const cv::Mat& mask2);
 
   // The last call's raw numbers (for evaluation tools).
@@ -102,8 +120,9 @@ class SunCnnEstimator : public sunfusion::ImageSunEstimator {
   cv::dnn::Net net_;
   bool ready_ = false;
   std::mt19937_64 rng_;
-  cv::Mat small_;  // input_height x input_width, CV_8UC3
-  cv::Mat blob_;   // [1, 3, H, W] CV_32F
+  cv::Mat small3_;  // input_height x input_width, CV_8UC3 (colour images)
+  cv::Mat small1_;  // input_height x input_width, CV_8UC1 (grey images)
+  cv::Mat blob_;    // [1, C, H, W] CV_32F
   cv::Mat mask1_, mask2_, out_;
   std::vector<cv::Mat> outs_;
   SunCnnRaw raw_;

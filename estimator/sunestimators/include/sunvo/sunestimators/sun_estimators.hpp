@@ -18,8 +18,9 @@ std::vector<std::string> knownSunEstimators();
 bool needsColour(const std::string& name);
 
 // One estimator by name ("lalonde", "lalonde_vo", "sun_cnn"); sun_cnn loads the ONNX model at
-// model_path (its config/sun_cnn.json beside it is not read: SunCnnOptions' defaults are the
-// shipped model's). Not-found error for an unknown name; the model's errors name the file.
+// model_path with the options of the JSON beside it (name.onnx -> name.json, see
+// suncnn::loadSunCnnOptions; without one, SunCnnOptions' defaults, which are the shipped colour
+// model's). Not-found error for an unknown name; the model's errors name the file.
 Expected<std::unique_ptr<sunfusion::ImageSunEstimator>> makeSunEstimator(
     const std::string& name, const std::string& model_path);
 

@@ -72,12 +72,6 @@ inline bool sunProviderNeedsImages(SunProviderType type) {
          type == SunProviderType::kSunCnn;
 }
 
-// True for the providers that need the left colour image; Lalonde (acceptsGray) also runs on the
-// gray left image of a monochrome camera.
-inline bool sunProviderNeedsColour(SunProviderType type) {
-  return type == SunProviderType::kSunCnn;
-}
-
 // nullptr for provider none.
 Expected<std::unique_ptr<SunProvider>> makeSunProvider(const SunConfig& config,
                                                        const StereoCamera& camera);

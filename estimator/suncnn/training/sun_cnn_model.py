@@ -1,0 +1,97 @@
+"""Sun-CNN network, its exported graph and the uncertainty it reports (shared by training and
+evaluation).
+
+Model: a 5x5 stride-2 conv and three 3x3 convs (each BN, ReLU, 2x2 max-pool) on a 64x208 image
+(BGR for the colour model, one grey plane for the grey model; about 13.5 M multiply-adds),
+flattened (64 x 2 x 6 = 768 features), then dropout -> FC 128 -> ReLU -> dropout -> FC 2. The
+output v = (c, s) is regressed onto t = (cos az, sin az), az = atan2(sun_x, sun_z), with the
+squared chord ||v - t||^2 (targets on the unit circle). The minimiser of the expected chord loss
+is E[t | image], whose length is the mean resultant length of the azimuth posterior: images
+without sun cues are answered with a short vector.
+
+The shipped model is an ensemble of M such nets trained from different seeds (a deep ensemble:
+their disagreement is the out-of-distribution signal, which MC dropout in the head alone misses).
+
+Export (ONNX opset 11, read by OpenCV 4.6 DNN): inputs image [1,C,64,208], mask1 [K,768],
+mask2 [K,128]; output [M*K, 2]. Each member's trunk runs once, its features are repeated K
+times (Concat) and multiplied by the masks (inverted dropout: entries 0 or 1/(1-p); all ones =
+dropout off); rows m*K .. m*K+K-1 are member m. Row m*K (masks of ones) is member m's
+deterministic answer, rows m*K+1 .. m*K+N its MC samples; the caller owns the random numbers.
+"""
+import numpy as np
+import torch
+import torch.nn as nn
+
+IN_H, IN_W = 64, 208
+MEAN, STD = 0.5, 0.25  # x = (pixel / 255 - MEAN) / STD, every channel
+DROPOUT_P = 0.3
+K_ROWS = 32  # rows of each member's exported head (1 deterministic + up to 31 MC samples)
+FEAT, HIDDEN = 64 * 2 * 6, 128
+
+
+class SunCnn(nn.Module):
+    def __init__(self, channels):
+        super().__init__()
+        # 64x208 -> (5x5 stride-2 conv, pool) 16x52 -> 8x26 -> 4x13 -> 2x6 (x64 channels).
+        layers = [nn.Conv2d(channels, 16, 5, stride=2, padding=2, bias=False), nn.BatchNorm2d(16),
+                  nn.ReLU(), nn.MaxPool2d(2)]
+        for a, b in ((16, 32), (32, 64), (64, 64)):
+            layers += [nn.Conv2d(a, b, 3, padding=1, bias=False), nn.BatchNorm2d(b), nn.ReLU(),
+                       nn.MaxPool2d(2)]
+        self.trunk = nn.Sequential(*layers)
+        self.fc1 = nn.Linear(FEAT, HIDDEN)
+        self.fc2 = nn.Linear(HIDDEN, 2)
+        self.drop = nn.Dropout(DROPOUT_P)
+
+    def features(self, x):
+        return torch.flatten(self.trunk(x), 1)
+
+    def forward(self, x):
+        h = torch.relu(self.fc1(self.drop(self.features(x))))
+        return self.fc2(self.drop(h))
+
+
+class EnsembleExport(nn.Module):
+    """The exported graph: for every member, trunk once and K masked head passes."""
+
+    def __init__(self, members):
+        super().__init__()
+        self.members = nn.ModuleList(members)
+
+    def forward(self, image, mask1, mask2):
+        outs = []
+        for m in self.members:
+            f = torch.cat([m.features(image)] * K_ROWS, 0) * mask1
+            outs.append(m.fc2(torch.relu(m.fc1(f)) * mask2))
+        return torch.cat(outs, 0)
+
+
+def mc_predict(members, x, samples, gen):
+    """Per member: the deterministic output [n, 2] and `samples` dropout outputs [n, S, 2], with
+    masks drawn as the C++ side draws them (same masks for every member)."""
+    dets, samps = [], []
+    with torch.no_grad():
+        feats = [m.eval().features(x) for m in members]
+        masks = []
+        for _ in range(samples):
+            m1 = (torch.rand(feats[0].shape, generator=gen) >= DROPOUT_P).float() / (1 - DROPOUT_P)
+            m2 = (torch.rand((x.shape[0], HIDDEN), generator=gen) >= DROPOUT_P).float() / (1 - DROPOUT_P)
+            masks.append((m1, m2))
+        for m, f in zip(members, feats):
+            dets.append(m.fc2(torch.relu(m.fc1(f))).numpy())
+            samps.append(torch.stack([m.fc2(torch.relu(m.fc1(f * m1)) * m2) for m1, m2 in masks],
+                                     1).numpy())
+    return np.stack(dets, 0), np.stack(samps, 0)  # [M, n, 2], [M, n, S, 2]
+
+
+def combine(dets, samps):
+    """The answer and the raw spread as the C++ estimator computes them: the direction of the
+    mean deterministic vector of the members; R_al = its length, R_mc = the mean resultant
+    length of all M*S unit sample directions; raw sigma = sqrt(-2 ln R_mc - 2 ln R_al) (rad)."""
+    v = dets.mean(0)
+    u = samps / np.maximum(np.linalg.norm(samps, axis=3, keepdims=True), 1e-9)
+    m, n, s, _ = u.shape
+    r_mc = np.clip(np.linalg.norm(u.transpose(1, 0, 2, 3).reshape(n, m * s, 2).mean(1), axis=1),
+                   1e-6, 1.0)
+    r_al = np.clip(np.linalg.norm(v, axis=1), 1e-6, 1.0)
+    return v, np.sqrt(-2 * np.log(r_mc) - 2 * np.log(r_al))
