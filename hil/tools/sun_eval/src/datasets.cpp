@@ -7,11 +7,22 @@
 
 namespace sunvo::suneval {
 
+SetSpec parseSetSpec(const std::string& text) {
+  std::error_code ec;
+  const std::size_t colon = text.rfind(':');
+  if (colon == std::string::npos || colon + 1 == text.size() || std::filesystem::exists(text, ec)) {
+    return SetSpec{text, ""};
+  }
+  return SetSpec{text.substr(0, colon), text.substr(colon + 1)};
+}
+
 Expected<EvalDataset> loadEvalDataset(const std::string& dir, int max_frames,
-                                      std::optional<std::int64_t> utc_offset_s) {
+                                      std::optional<std::int64_t> utc_offset_s,
+                                      const std::string& sun_csv) {
   dataset::DatasetOptions o;
   o.path = dir;
   o.utc_offset_s = utc_offset_s;
+  o.sun_csv = sun_csv;
   if (max_frames > 0) o.last_frame = max_frames - 1;
   auto ds = dataset::Dataset::open(o);
   if (!ds && max_frames > 0 &&

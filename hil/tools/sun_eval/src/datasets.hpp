@@ -6,6 +6,10 @@
 // gray camera 0. "Up" in the camera is C_c_w up_w: exact for ENU worlds; for KITTI odometry poses,
 // which carry no gravity, up_w is the first camera's -y (KITTI's rig is mounted level to about a
 // degree), which the set records in `level_assumed`.
+//
+// A set is named on the command line as DIR or DIR:CSV, CSV being a frame,sx,sy,sz file of the
+// true sun in camera 0 that replaces the one the dataset would find (DIR/sun_cam.csv,
+// DIR/../<NN>_sun_cam.csv, a render's gt/sun_cam0.csv).
 
 #include <Eigen/Core>
 #include <optional>
@@ -30,8 +34,18 @@ struct EvalDataset {
   bool level_assumed = false;
 };
 
-// max_frames > 0 keeps only the first max_frames frames; utc_offset_s: see DatasetOptions.
+struct SetSpec {
+  std::string dir;
+  std::string sun_csv;  // "" = the dataset's own
+};
+
+// "DIR" or "DIR:CSV" (split at the last ':' unless the whole text is an existing path).
+SetSpec parseSetSpec(const std::string& text);
+
+// max_frames > 0 keeps only the first max_frames frames; utc_offset_s: see DatasetOptions;
+// sun_csv: see SetSpec.
 Expected<EvalDataset> loadEvalDataset(const std::string& dir, int max_frames,
-                                      std::optional<std::int64_t> utc_offset_s = std::nullopt);
+                                      std::optional<std::int64_t> utc_offset_s = std::nullopt,
+                                      const std::string& sun_csv = "");
 
 }  // namespace sunvo::suneval
