@@ -3,6 +3,7 @@
 #include <filesystem>
 
 #include "sunvo/dataset/dataset.hpp"
+#include "sunvo/files/sun_csv.hpp"
 #include "sunvo/kitti/stereo_source.hpp"
 
 namespace sunvo::suneval {
@@ -32,7 +33,21 @@ Expected<EvalDataset> loadEvalDataset(const std::string& dir, int max_frames,
   }
   if (!ds) return ds.status();
   if (!ds->hasImages()) return invalidArgument(dir + ": no images (" + ds->describe() + ")");
-  if (!ds->sunKnown()) return notFound(dir + ": no true sun: " + ds->sunUnknownReason());
+  // A sun file but no poses (a KITTI odometry test sequence): the sun in camera 0 is all the
+  // evaluation needs; "up" is then the camera's -y, the rig taken as level.
+  std::vector<Eigen::Vector3d> csv_sun_c;
+  if (!ds->sunKnown() && !sun_csv.empty() && !ds->hasGroundTruth() && ds->size() > 0) {
+    auto sun = files::readSunCsv(sun_csv);
+    if (!sun) return sun.status();
+    const auto need = static_cast<std::size_t>(ds->recordingIndex(ds->size() - 1)) + 1;
+    if (sun->sun_c.size() < need) {
+      return invalidArgument(sun_csv + ": " + std::to_string(sun->sun_c.size()) +
+                             " rows, fewer than the " + std::to_string(need) + " frames");
+    }
+    csv_sun_c = std::move(sun->sun_c);
+  } else if (!ds->sunKnown()) {
+    return notFound(dir + ": no true sun: " + ds->sunUnknownReason());
+  }
   kitti::KittiSourceOptions so = ds->imageSourceOptions();
   so.use_color = ds->colorCamera().has_value();
   auto source = kitti::KittiStereoSource::open(so);
@@ -42,13 +57,18 @@ Expected<EvalDataset> loadEvalDataset(const std::string& dir, int max_frames,
   if (p.filename().empty()) p = p.parent_path();
   out.name = p.filename().string();
   out.camera = so.use_color ? *ds->colorCamera() : ds->camera();
-  out.level_assumed = ds->world() == dataset::WorldFrame::kFirstCamera;
+  out.level_assumed = ds->world() == dataset::WorldFrame::kFirstCamera || !csv_sun_c.empty();
   const Eigen::Vector3d up_w = ds->worldUp();
   for (std::size_t k = 0; k < ds->size(); ++k) {
     EvalFrame f;
     f.image_path = source->imagePath(so.use_color ? 2 : 0, ds->recordingIndex(k));
-    f.true_sun_c = ds->trueSun()[k].sun_c;
-    f.true_up_c = ds->groundTruth()[k].linear().transpose() * up_w;
+    if (csv_sun_c.empty()) {
+      f.true_sun_c = ds->trueSun()[k].sun_c;
+      f.true_up_c = ds->groundTruth()[k].linear().transpose() * up_w;
+    } else {
+      f.true_sun_c = csv_sun_c[static_cast<std::size_t>(ds->recordingIndex(k))].normalized();
+      f.true_up_c = -Eigen::Vector3d::UnitY();
+    }
     out.frames.push_back(f);
   }
   return out;
