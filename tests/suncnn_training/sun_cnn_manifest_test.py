@@ -210,9 +210,49 @@ class TrainScript(Base):
         self.assertIn("--real needs", p.stderr)
 
 
+class EndToEnd(Base):
+    """The real frames through the manifest (frames 0-5 train, 6-10 val), the trainer (one epoch:
+    the path is tested, not the accuracy; 12 images are far too few) and sunvo_sun_eval with the
+    model it wrote."""
+
+    def test_real_frames_train_and_appear_in_the_evaluation(self):
+        if not ARGS.trainer or not ARGS.sun_eval:
+            self.skipTest("needs --trainer and --sun-eval")
+        with open(ARGS.sun_csv) as f:
+            lines = f.read().splitlines()
+        parts = {"train": lines[0:7], "val": [lines[0]] + lines[7:12]}  # header + frames
+        args = []
+        for split, part in parts.items():
+            path = os.path.join(self.work, f"sun_{split}.csv")
+            with open(path, "w") as f:
+                f.write("\n".join(part) + "\n")
+            args += ["--real", f"{ARGS.frames}:{path}:{split}"]
+        manifest, _ = self.manifest(*args)
+        model_dir = os.path.join(self.work, "model")
+        os.makedirs(model_dir)
+        p = subprocess.run([sys.executable, ARGS.trainer, "--manifest", manifest, "--out-dir",
+                            model_dir, "--reference", os.path.join(model_dir, "reference.txt"),
+                            "--epochs", "1", "--threads", "1"],
+                           capture_output=True, text=True)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        name = "real_" + os.path.basename(os.path.normpath(ARGS.frames))
+        self.assertIn(name, p.stderr)  # the held-out report names the real scenario
+        model = os.path.join(model_dir, "sun_cnn.onnx")
+        self.assertGreater(os.path.getsize(model), 1000)
+        out = os.path.join(self.work, "eval")
+        p = subprocess.run([ARGS.sun_eval, "--images", ARGS.frames, "--estimators", "sun_cnn",
+                            "--model", model, "--out", out, "--debug", "0"],
+                           capture_output=True, text=True)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        set_name = os.path.basename(os.path.normpath(ARGS.frames))
+        self.assertIn(f"| sun_cnn | {set_name} | 11 |", p.stdout)
+
+
 if __name__ == "__main__":
     ap = argparse.ArgumentParser()
     for name in ("--manifest-script", "--train-script", "--frames", "--sun-csv", "--work"):
         ap.add_argument(name, required=True)
+    ap.add_argument("--trainer", default="")  # sun_cnn_train.py (EndToEnd only)
+    ap.add_argument("--sun-eval", default="")  # the sunvo_sun_eval program (EndToEnd only)
     ARGS, rest = ap.parse_known_args()
     unittest.main(argv=[sys.argv[0]] + rest, verbosity=2)
