@@ -11,6 +11,8 @@
 
 namespace {
 namespace fs = std::filesystem;
+using sunvo::suneval::CameraChoice;
+using sunvo::suneval::EvalSetOptions;
 using sunvo::suneval::loadEvalDataset;
 using sunvo::suneval::parseSetSpec;
 const std::string kOdometry = std::string(SUNVO_DATA_DIR) + "/kitti_odometry";
@@ -26,8 +28,10 @@ TEST(SunEvalDatasets, ParsesDirAndDirColonCsv) {
 }
 
 TEST(SunEvalDatasets, AnExplicitSunFileGivesTheSameSunAsTheFoundOne) {
-  auto found = loadEvalDataset(kFrames, 0);
-  auto given = loadEvalDataset(kFrames, 0, std::nullopt, kOdometry + "/00_sun_cam.csv");
+  auto found = loadEvalDataset(kFrames);
+  EvalSetOptions o;
+  o.sun_csv = kOdometry + "/00_sun_cam.csv";
+  auto given = loadEvalDataset(kFrames, o);
   ASSERT_TRUE(found) << found.status().toString();
   ASSERT_TRUE(given) << given.status().toString();
   ASSERT_EQ(found->frames.size(), 11u);
@@ -38,6 +42,24 @@ TEST(SunEvalDatasets, AnExplicitSunFileGivesTheSameSunAsTheFoundOne) {
   EXPECT_EQ(found->name, "00_first_frames");
 }
 
+TEST(SunEvalDatasets, TheCameraChoice) {
+  // The real frames are gray only: auto and gray give camera 0, color is an error naming the set.
+  for (CameraChoice c : {CameraChoice::kAuto, CameraChoice::kGray}) {
+    EvalSetOptions o;
+    o.camera = c;
+    auto ds = loadEvalDataset(kFrames, o);
+    ASSERT_TRUE(ds) << ds.status().toString();
+    EXPECT_FALSE(ds->color);
+    EXPECT_NE(ds->frames[0].image_path.find("image_0/"), std::string::npos);
+  }
+  EvalSetOptions o;
+  o.camera = CameraChoice::kColor;
+  auto ds = loadEvalDataset(kFrames, o);
+  ASSERT_FALSE(ds);
+  EXPECT_NE(ds.status().message().find("00_first_frames: no colour camera"), std::string::npos)
+      << ds.status().message();
+}
+
 TEST(SunEvalDatasets, ASunFileWithoutPosesTakesTheRigAsLevel) {
   // A copy of the frames alone (no poses, no sun file next to it).
   const fs::path dir = fs::path(SUNVO_BINARY_DIR) /
@@ -45,8 +67,11 @@ TEST(SunEvalDatasets, ASunFileWithoutPosesTakesTheRigAsLevel) {
   fs::remove_all(dir.parent_path());
   fs::create_directories(dir);
   fs::copy(kFrames, dir, fs::copy_options::recursive);
-  EXPECT_FALSE(loadEvalDataset(dir.string(), 3));  // no sun: an error
-  auto ds = loadEvalDataset(dir.string(), 3, std::nullopt, kOdometry + "/00_sun_cam.csv");
+  EvalSetOptions o;
+  o.max_frames = 3;
+  EXPECT_FALSE(loadEvalDataset(dir.string(), o));  // no sun: an error
+  o.sun_csv = kOdometry + "/00_sun_cam.csv";
+  auto ds = loadEvalDataset(dir.string(), o);
   ASSERT_TRUE(ds) << ds.status().toString();
   ASSERT_EQ(ds->frames.size(), 3u);
   EXPECT_TRUE(ds->level_assumed);
@@ -58,7 +83,8 @@ TEST(SunEvalDatasets, ASunFileWithoutPosesTakesTheRigAsLevel) {
   // A sun file with fewer rows than frames: an error naming it.
   const fs::path short_csv = dir.parent_path() / "short.csv";
   std::ofstream(short_csv) << "frame,sx,sy,sz\n0,0.23639,-0.57199,-0.78546\n";
-  auto bad = loadEvalDataset(dir.string(), 3, std::nullopt, short_csv.string());
+  o.sun_csv = short_csv.string();
+  auto bad = loadEvalDataset(dir.string(), o);
   ASSERT_FALSE(bad);
   EXPECT_NE(bad.status().message().find("short.csv"), std::string::npos) << bad.status().message();
   if (!::testing::Test::HasFailure()) fs::remove_all(dir.parent_path());

@@ -26,7 +26,9 @@ TEST(SunEvalLalondeCues, AxialErrorFoldsTheTwoShadowDirections) {
 class CuesOnARealFrame : public ::testing::Test {
  protected:
   void run(const sunvo::sunvision::LalondeOptions& options) {
-    auto ds = sunvo::suneval::loadEvalDataset(kFrames, 1);
+    sunvo::suneval::EvalSetOptions o;
+    o.max_frames = 1;
+    auto ds = sunvo::suneval::loadEvalDataset(kFrames, o);
     ASSERT_TRUE(ds) << ds.status().toString();
     estimator_ = sunvo::sunvision::LalondeEstimator(options);
     ASSERT_TRUE(estimator_.init());

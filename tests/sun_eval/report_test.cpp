@@ -15,6 +15,7 @@ std::vector<SetResult> twoResults() {
   SetResult a;
   a.estimator = "lalonde";
   a.set = "setA";
+  a.camera = "color";
   FrameResult f;
   f.valid = true;
   f.azimuth_error_deg = -12.5;
@@ -26,6 +27,7 @@ std::vector<SetResult> twoResults() {
   SetResult b;
   b.estimator = "sun_cnn";
   b.set = "setB";
+  b.camera = "gray";
   FrameResult g;  // invalid, no direction
   b.frames = {g, g};
   b.summary = summarize(b.frames);
@@ -42,6 +44,8 @@ TEST(SunEvalReport, MarkdownHasOneRowPerSetAndEstimatorAndOnePerCue) {
   EXPECT_NE(md.find("| lalonde | setA | sky | 100 % (1/1) | 20.0° |"), std::string::npos) << md;
   EXPECT_NE(md.find("| lalonde | setA | shadow | 0 % (0/1) | – |"), std::string::npos) << md;
   EXPECT_EQ(md.find("| sun_cnn | setB | sky"), std::string::npos);
+  EXPECT_NE(md.find("Cameras: setA colour (camera 2), setB gray (camera 0)."), std::string::npos)
+      << md;
 }
 
 TEST(SunEvalReport, CsvLeavesUndefinedFieldsEmpty) {
@@ -58,6 +62,7 @@ TEST(SunEvalReport, CsvLeavesUndefinedFieldsEmpty) {
   }
   EXPECT_NE(csv.find("lalonde,setA,1,1,12.5,12.5,-12.5,0,,1,"), std::string::npos) << csv;
   EXPECT_NE(csv.find("sun_cnn,setB,2,0,,,,,,,"), std::string::npos) << csv;
+  EXPECT_NE(csv.find(",,,,,,,gray\n"), std::string::npos) << csv;  // no cues; the camera last
   EXPECT_EQ(csv.find("nan"), std::string::npos);
 }
 

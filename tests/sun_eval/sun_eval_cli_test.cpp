@@ -130,6 +130,10 @@ TEST(SunEvalCli, RejectsBadArgumentsAndInputs) {
   EXPECT_EQ(run("--images " + kFrames + " --out " + kOut + " --estimators nope"), 2);
   EXPECT_NE(slurp(kOut + "_stderr.txt").find("nope"), std::string::npos);
   EXPECT_EQ(run("--images " + kFrames + " --out " + kOut + " --frames x"), 2);
+  // --camera color on gray-only frames: a runtime failure naming the set; a bad camera name: usage.
+  EXPECT_EQ(run("--images " + kFrames + " --out " + kOut + " --camera color"), 1);
+  EXPECT_NE(slurp(kOut + "_stderr.txt").find("no colour camera"), std::string::npos);
+  EXPECT_EQ(run("--images " + kFrames + " --out " + kOut + " --camera infrared"), 2);
   // DIR:CSV with a CSV that is not there: a usage error naming it.
   EXPECT_EQ(run("--images " + kFrames + ":/nonexistent/sun.csv --out " + kOut), 2);
   EXPECT_NE(slurp(kOut + "_stderr.txt").find("/nonexistent/sun.csv"), std::string::npos);

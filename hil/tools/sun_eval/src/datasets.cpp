@@ -17,12 +17,12 @@ SetSpec parseSetSpec(const std::string& text) {
   return SetSpec{text.substr(0, colon), text.substr(colon + 1)};
 }
 
-Expected<EvalDataset> loadEvalDataset(const std::string& dir, int max_frames,
-                                      std::optional<std::int64_t> utc_offset_s,
-                                      const std::string& sun_csv) {
+Expected<EvalDataset> loadEvalDataset(const std::string& dir, const EvalSetOptions& options) {
+  const int max_frames = options.max_frames;
+  const std::string& sun_csv = options.sun_csv;
   dataset::DatasetOptions o;
   o.path = dir;
-  o.utc_offset_s = utc_offset_s;
+  o.utc_offset_s = options.utc_offset_s;
   o.sun_csv = sun_csv;
   if (max_frames > 0) o.last_frame = max_frames - 1;
   auto ds = dataset::Dataset::open(o);
@@ -49,7 +49,10 @@ Expected<EvalDataset> loadEvalDataset(const std::string& dir, int max_frames,
     return notFound(dir + ": no true sun: " + ds->sunUnknownReason());
   }
   kitti::KittiSourceOptions so = ds->imageSourceOptions();
-  so.use_color = ds->colorCamera().has_value();
+  if (options.camera == CameraChoice::kColor && !ds->colorCamera()) {
+    return invalidArgument(dir + ": no colour camera (image_2 or image_02) for --camera color");
+  }
+  so.use_color = ds->colorCamera().has_value() && options.camera != CameraChoice::kGray;
   auto source = kitti::KittiStereoSource::open(so);
   if (!source) return source.status();
   EvalDataset out;
@@ -57,6 +60,7 @@ Expected<EvalDataset> loadEvalDataset(const std::string& dir, int max_frames,
   if (p.filename().empty()) p = p.parent_path();
   out.name = p.filename().string();
   out.camera = so.use_color ? *ds->colorCamera() : ds->camera();
+  out.color = so.use_color;
   out.level_assumed = ds->world() == dataset::WorldFrame::kFirstCamera || !csv_sun_c.empty();
   const Eigen::Vector3d up_w = ds->worldUp();
   for (std::size_t k = 0; k < ds->size(); ++k) {

@@ -32,6 +32,7 @@ struct EvalDataset {
   StereoCamera camera;
   std::vector<EvalFrame> frames;
   bool level_assumed = false;
+  bool color = false;  // colour camera 2 (else gray camera 0)
 };
 
 struct SetSpec {
@@ -42,10 +43,19 @@ struct SetSpec {
 // "DIR" or "DIR:CSV" (split at the last ':' unless the whole text is an existing path).
 SetSpec parseSetSpec(const std::string& text);
 
-// max_frames > 0 keeps only the first max_frames frames; utc_offset_s: see DatasetOptions;
-// sun_csv: see SetSpec.
-Expected<EvalDataset> loadEvalDataset(const std::string& dir, int max_frames,
-                                      std::optional<std::int64_t> utc_offset_s = std::nullopt,
-                                      const std::string& sun_csv = "");
+enum class CameraChoice {
+  kAuto,   // colour camera 2 when the set has it, else gray camera 0
+  kColor,  // camera 2; a set without it is an error
+  kGray,   // camera 0, also where the set has colour (e.g. for a gray model on a render)
+};
+
+struct EvalSetOptions {
+  int max_frames = 0;  // > 0: only the first max_frames frames (all when there are fewer)
+  std::optional<std::int64_t> utc_offset_s;  // see dataset::DatasetOptions
+  std::string sun_csv;                       // see SetSpec
+  CameraChoice camera = CameraChoice::kAuto;
+};
+
+Expected<EvalDataset> loadEvalDataset(const std::string& dir, const EvalSetOptions& options = {});
 
 }  // namespace sunvo::suneval

@@ -22,6 +22,7 @@
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
+#include <map>
 #include <numbers>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -64,6 +65,7 @@ struct Args {
   unsigned long long seed = 1;
   int debug = 2;
   int threads = 1;
+  se::CameraChoice camera = se::CameraChoice::kAuto;
 };
 
 // CPU time of the whole process, ms: with one OpenCV thread (the default) the cost of a call on
@@ -101,8 +103,12 @@ Expected<std::vector<se::EvalDataset>> loadSets(const Args& args) {
   std::vector<se::EvalDataset> sets;
   for (const std::string& text : args.images) {
     const se::SetSpec spec = se::parseSetSpec(text);
-    Expected<se::EvalDataset> ds =
-        se::loadEvalDataset(spec.dir, args.frames, args.utc_offset_s, spec.sun_csv);
+    se::EvalSetOptions o;
+    o.max_frames = args.frames;
+    o.utc_offset_s = args.utc_offset_s;
+    o.sun_csv = spec.sun_csv;
+    o.camera = args.camera;
+    Expected<se::EvalDataset> ds = se::loadEvalDataset(spec.dir, o);
     if (!ds) return ds.status();
     const std::string base = ds->name;
     for (int k = 2;; ++k) {
@@ -155,6 +161,7 @@ int run(const Args& args) {
     for (std::size_t ei = 0; ei < n_est; ++ei) {
       per[ei].estimator = (*estimators)[ei]->name();
       per[ei].set = ds.name;
+      per[ei].camera = ds.color ? "color" : "gray";
       csv[ei] << "frame,valid,azimuth_deg,zenith_deg,true_azimuth_deg,true_zenith_deg,"
                  "azimuth_error_deg,zenith_error_deg,sigma,azimuth_sigma_deg,confidence,gate,"
                  "time_ms,cpu_ms\n";
@@ -304,6 +311,13 @@ int main(int argc, char** argv) {
   app.add_option("--seed", args.seed, "seed of that error");
   app.add_option("--debug", args.debug, "debug panels for the first N frames of each set")
       ->check(CLI::Range(0, 1000000));
+  const std::map<std::string, se::CameraChoice> cameras = {{"auto", se::CameraChoice::kAuto},
+                                                           {"color", se::CameraChoice::kColor},
+                                                           {"gray", se::CameraChoice::kGray}};
+  app.add_option("--camera", args.camera,
+                 "auto: the colour camera 2 where a set has it, else the gray camera 0; color: "
+                 "camera 2 (a set without it fails); gray: camera 0 everywhere")
+      ->transform(CLI::CheckedTransformer(cameras, CLI::ignore_case));
   app.add_option("--threads", args.threads,
                  "OpenCV threads (1: CPU time per call is the cost on one core)")
       ->check(CLI::Range(1, 64));

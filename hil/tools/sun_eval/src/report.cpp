@@ -78,7 +78,15 @@ std::string markdownReport(const std::vector<SetResult>& results, const ReportMe
         "sigma is calibrated); kept = accepted by the default sun gate against the true-pose "
         "prediction, over all frames; CPU = process CPU time per call. VO prior attitude error "
      << formatNumber(meta.prior_error_deg) << " deg per axis (1 sigma), seed " << meta.seed
-     << "; OpenCV threads " << meta.threads << ".\n\n"
+     << "; OpenCV threads " << meta.threads << ". Cameras:";
+  std::string last_set;
+  for (const SetResult& r : results) {
+    if (r.set == last_set) continue;
+    md << (last_set.empty() ? " " : ", ") << r.set << " "
+       << (r.camera == "color" ? "colour (camera 2)" : "gray (camera 0)");
+    last_set = r.set;
+  }
+  md << ".\n\n"
      << "| estimator | set | frames | valid | az. median | az. p90 | bias | gross | "
         "gross flagged | < 2σ | zen. median | kept by gate | CPU ms/call median | p90 |\n"
      << "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: "
@@ -124,6 +132,7 @@ std::string jsonReport(const std::vector<SetResult>& results, const ReportMeta& 
   for (const SetResult& r : results) {
     const EstimatorSummary& s = r.summary;
     w.beginObject().key("estimator").value(r.estimator).key("dataset").value(r.set);
+    w.key("camera").value(r.camera);
     w.key("frames").value(s.frames).key("valid").value(s.valid);
     w.key("valid_share").value(s.valid_share);
     w.key("azimuth_abs_error_deg_median").value(s.azimuth_median_deg);
@@ -165,7 +174,7 @@ std::string csvReport(const std::vector<SetResult>& results) {
   csv << "estimator,set,frames,valid_share,azimuth_median_deg,azimuth_p90_deg,azimuth_bias_deg,"
          "gross_share,gross_flagged_invalid_share,within_2sigma_share,zenith_median_deg,"
          "kept_share,cpu_ms_median,cpu_ms_p90,sky_informative_share,sky_median_deg,"
-         "sky_gross_share,shadow_informative_share,shadow_median_deg,shadow_gross_share\n";
+         "sky_gross_share,shadow_informative_share,shadow_median_deg,shadow_gross_share,camera\n";
   for (const SetResult& r : results) {
     const EstimatorSummary& s = r.summary;
     csv << r.estimator << ',' << r.set << ',' << s.frames;
@@ -179,7 +188,7 @@ std::string csvReport(const std::vector<SetResult>& results) {
       csv << ',' << (c ? csvNumber(c->informative_share) : "") << ','
           << (c ? csvNumber(c->median_deg) : "") << ',' << (c ? csvNumber(c->gross_share) : "");
     }
-    csv << '\n';
+    csv << ',' << r.camera << '\n';
   }
   return csv.str();
 }

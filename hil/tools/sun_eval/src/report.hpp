@@ -18,6 +18,7 @@ struct CueResults {
 // One estimator on one set.
 struct SetResult {
   std::string estimator, set;
+  std::string camera;  // "color" (camera 2) or "gray" (camera 0)
   std::vector<FrameResult> frames;
   EstimatorSummary summary;
   std::optional<CueResults> cues;  // Lalonde estimators only
