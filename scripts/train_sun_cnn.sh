@@ -5,21 +5,44 @@
 #
 #   bash scripts/train_sun_cnn.sh                 # render what is missing, then train
 #   bash scripts/train_sun_cnn.sh --render-only   # only render (and write the manifest)
+#   bash scripts/train_sun_cnn.sh --real DIR:CSV[:SPLIT] ...   # real labelled images as well
+#   bash scripts/train_sun_cnn.sh --no-render --real DIR:CSV:train ...  # no rendering
+#
+# --real DIR:CSV[:SPLIT] (repeatable) adds a real KITTI odometry folder (image_0/1 gray, image_2/3
+# colour) or KITTI raw drive folder (image_00..03/data) with its per-frame sun file (CSV
+# frame,sx,sy,sz, the sun in camera 0, e.g. ../shared/data/kitti_odometry/00_sun_cam.csv) to the
+# manifest as scenario real_<folder name>; SPLIT is train, val or test (default test: held out,
+# reported only). --no-render renders nothing: the manifest lists the renders already complete
+# under $SUNVO_RENDERS (none is fine) and the --real folders; with --render-only as well, the
+# script only writes the manifest. See estimator/suncnn/training/sun_cnn_manifest.py.
 #
 # Needs: the sunvo_render tool (built here if missing), povray, and python3-torch
 # (bash scripts/setup.sh --train). Renders go to $SUNVO_RENDERS (default /work/renders), one
 # folder per scenario (config/scenarios/): train_* (training; styled, training looks), val_*
 # (validation: held-out places, times and looks; the sigma scale and validity threshold are
 # chosen on it) and test_* (held-out looks, reported only).
+# The manifest is $SUNVO_RENDERS/sun_cnn_manifest.csv.
 set -euo pipefail
 ROOT="$(cd "$(dirname "$0")/.." && pwd)"
 BUILD="${SUNVO_BUILD:-$ROOT/build/release}"
 RENDERS="${SUNVO_RENDERS:-/work/renders}"
 JOBS="${JOBS:-2}"
 PY=/usr/bin/python3  # Debian's interpreter, the one python3-torch is installed for
-MODE="${1:-all}"
+MODE=all
+RENDER=1
+REAL=()
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --render-only) MODE=--render-only; shift ;;
+    --no-render) RENDER=0; shift ;;
+    --real)
+      [ $# -ge 2 ] || { echo "train_sun_cnn: --real needs DIR:CSV[:SPLIT]" >&2; exit 2; }
+      REAL+=(--real "$2"); shift 2 ;;
+    *) echo "train_sun_cnn: unknown argument $1" >&2; exit 2 ;;
+  esac
+done
 
-if [ ! -x "$BUILD/bin/sunvo_render" ]; then
+if [ "$RENDER" = 1 ] && [ ! -x "$BUILD/bin/sunvo_render" ]; then
   (cd "$ROOT" && cmake --preset release >/dev/null && cmake --build "$BUILD" --target sunvo_render_tool)
 fi
 
@@ -31,6 +54,7 @@ for yaml in "$ROOT"/config/scenarios/train_*.yaml "$ROOT"/config/scenarios/val_*
   # RENDERED holds the SHA-256 of the scenario it was rendered from: a changed scenario renders again.
   want="$(sha256sum "$yaml" | cut -d' ' -f1)"
   if [ -f "$out/RENDERED" ] && [ "$(cat "$out/RENDERED")" = "$want" ]; then continue; fi
+  [ "$RENDER" = 1 ] || continue  # --no-render: leave what is (not) rendered as it is
   rm -rf "$out"
   echo "train_sun_cnn: rendering $name"
   nice -n 10 "$BUILD/bin/sunvo_render" --scenario "$yaml" --out "$out" -j "$JOBS"
@@ -39,7 +63,7 @@ for yaml in "$ROOT"/config/scenarios/train_*.yaml "$ROOT"/config/scenarios/val_*
 done
 
 "$PY" "$ROOT/estimator/suncnn/training/sun_cnn_manifest.py" --renders "$RENDERS" \
-  --out "$RENDERS/sun_cnn_manifest.csv"
+  --out "$RENDERS/sun_cnn_manifest.csv" "${REAL[@]}"
 [ "$MODE" = "--render-only" ] && exit 0
 
 "$PY" -c "import torch" 2>/dev/null || {

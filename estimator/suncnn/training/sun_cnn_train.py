@@ -251,7 +251,10 @@ def main():
             err, raw, scen = evaluate(members, data[split], a.channels, a.seed)
             results[split] = report(err, raw, scen, scale, threshold)
     for split, r in results.items():
-        log(f"{split}: " + json.dumps(r["all"]))
+        for scenario, m in r.items():
+            log(f"{split} {scenario}: median {m['median_deg']:.1f} deg, p90 {m['p90_deg']:.1f}, "
+                f"bias {m['signed_median_deg']:+.1f}, gross {100 * m['gross_share']:.1f} %, "
+                f"valid {100 * m['valid_share']:.0f} %, n {m['images']}")
 
     onnx_path = os.path.join(a.out_dir, a.name + ".onnx")
     ex = EnsembleExport(members).eval()

@@ -6,6 +6,10 @@
 // gray camera 0. "Up" in the camera is C_c_w up_w: exact for ENU worlds; for KITTI odometry poses,
 // which carry no gravity, up_w is the first camera's -y (KITTI's rig is mounted level to about a
 // degree), which the set records in `level_assumed`.
+//
+// A set is named on the command line as DIR or DIR:CSV, CSV being a frame,sx,sy,sz file of the
+// true sun in camera 0 that replaces the one the dataset would find (DIR/sun_cam.csv,
+// DIR/../<NN>_sun_cam.csv, a render's gt/sun_cam0.csv).
 
 #include <Eigen/Core>
 #include <optional>
@@ -28,10 +32,30 @@ struct EvalDataset {
   StereoCamera camera;
   std::vector<EvalFrame> frames;
   bool level_assumed = false;
+  bool color = false;  // colour camera 2 (else gray camera 0)
 };
 
-// max_frames > 0 keeps only the first max_frames frames; utc_offset_s: see DatasetOptions.
-Expected<EvalDataset> loadEvalDataset(const std::string& dir, int max_frames,
-                                      std::optional<std::int64_t> utc_offset_s = std::nullopt);
+struct SetSpec {
+  std::string dir;
+  std::string sun_csv;  // "" = the dataset's own
+};
+
+// "DIR" or "DIR:CSV" (split at the last ':' unless the whole text is an existing path).
+SetSpec parseSetSpec(const std::string& text);
+
+enum class CameraChoice {
+  kAuto,   // colour camera 2 when the set has it, else gray camera 0
+  kColor,  // camera 2; a set without it is an error
+  kGray,   // camera 0, also where the set has colour (e.g. for a gray model on a render)
+};
+
+struct EvalSetOptions {
+  int max_frames = 0;  // > 0: only the first max_frames frames (all when there are fewer)
+  std::optional<std::int64_t> utc_offset_s;  // see dataset::DatasetOptions
+  std::string sun_csv;                       // see SetSpec
+  CameraChoice camera = CameraChoice::kAuto;
+};
+
+Expected<EvalDataset> loadEvalDataset(const std::string& dir, const EvalSetOptions& options = {});
 
 }  // namespace sunvo::suneval
