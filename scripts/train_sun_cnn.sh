@@ -70,9 +70,18 @@ done
   echo "train_sun_cnn: python3-torch missing: bash scripts/setup.sh --train" >&2
   exit 1
 }
+# The colour and the grey model train side by side, one thread each (a model is reproducible
+# for a given thread count); their logs go to $RENDERS/train_<name>.log.
+pids=()
 for model in colour gray; do
   if [ "$model" = colour ]; then name=sun_cnn channels=3; else name=sun_cnn_gray channels=1; fi
-  (cd "$ROOT/estimator/suncnn/training" && nice -n 10 "$PY" sun_cnn_train.py \
+  (cd "$ROOT/estimator/suncnn/training" && nice -n 10 "$PY" sun_cnn_train.py --threads 1 \
     --manifest "$RENDERS/sun_cnn_manifest.csv" --out-dir "$ROOT/config" --name "$name" \
-    --channels "$channels" --reference "$ROOT/tests/suncnn/data/${name}_reference.txt")
+    --channels "$channels" --reference "$ROOT/tests/suncnn/data/${name}_reference.txt" \
+    >"$RENDERS/train_$name.log" 2>&1) &
+  pids+=($!)
 done
+status=0
+for p in "${pids[@]}"; do wait "$p" || status=1; done
+tail -n 25 "$RENDERS"/train_sun_cnn*.log
+exit "$status"
