@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <numbers>
@@ -72,6 +73,9 @@ Status LalondeOptions::validate() const {
   if (!inRange(sky_turbidity, 1.7, 10.0)) return outOfRange("sky_turbidity", "[1.7, 10]");
   if (!inRange(sky_min_gray, 0.0, 255.0)) return outOfRange("sky_min_gray", "[0, 255]");
   if (!inRange(sky_max_gradient, 0.5, 255.0)) return outOfRange("sky_max_gradient", "[0.5, 255]");
+  if (!inRange(sky_min_relative_gray, 0.0, 1.0)) {
+    return outOfRange("sky_min_relative_gray", "[0, 1]");
+  }
   if (!inRange(sky_max_red_over_blue, 0.5, 5.0)) {
     return outOfRange("sky_max_red_over_blue", "[0.5, 5]");
   }
@@ -297,6 +301,34 @@ void LalondeEstimator::skyCue(const cv::Mat& work_bgr, const cv::Mat& work_gray,
   cues_.sky_mask.create(h, w, CV_8U);
   cues_.sky_mask.setTo(0);
   const double min_up = std::sin(options_.sky_min_elevation_deg * kDeg);
+  // The image's own levels: grey-world channel means (white balance) and the 99th percentile of
+  // the gray above the horizon (exposure and tone curve).
+  double red_gain = 1.0;  // multiplies R / B
+  if (colour && options_.sky_grey_world) {
+    const cv::Scalar mean_bgr = cv::mean(work_bgr);
+    red_gain = std::max(mean_bgr[0], 1.0) / std::max(mean_bgr[2], 1.0);
+  }
+  double min_gray = options_.sky_min_gray;
+  if (options_.sky_min_relative_gray > 0.0) {
+    std::array<int, 256> hist{};
+    int n_above = 0;
+    for (int y = 0; y < h; ++y) {
+      const unsigned char* g = work_gray.ptr<unsigned char>(y);
+      const Eigen::Vector3d d = rayAt((0.5 * w) * scale - 0.5, (y + 0.5) * scale - 0.5);
+      if (d.dot(cues_.horizon.up_c) < min_up) continue;
+      for (int x = 0; x < w; ++x) ++hist[g[x]];
+      n_above += w;
+    }
+    int acc = 0, p99 = 255;
+    for (int v = 255; v >= 0; --v) {
+      acc += hist[static_cast<std::size_t>(v)];
+      if (acc >= n_above / 100 + 1) {
+        p99 = v;
+        break;
+      }
+    }
+    min_gray = std::max(min_gray, options_.sky_min_relative_gray * p99);
+  }
   const float max_grad2 = static_cast<float>(options_.sky_max_gradient * options_.sky_max_gradient);
   for (int y = 0; y < h; ++y) {
     const unsigned char* g = work_gray.ptr<unsigned char>(y);
@@ -305,9 +337,10 @@ void LalondeEstimator::skyCue(const cv::Mat& work_bgr, const cv::Mat& work_gray,
     const float* gy = gradient_y_.ptr<float>(y);
     unsigned char* m = cues_.sky_mask.ptr<unsigned char>(y);
     for (int x = 0; x < w; ++x) {
-      if (g[x] < options_.sky_min_gray) continue;
+      if (g[x] < min_gray) continue;
       if (gx[x] * gx[x] + gy[x] * gy[x] > max_grad2) continue;
-      if (colour && bgr[x][2] > options_.sky_max_red_over_blue * std::max<int>(bgr[x][0], 1)) {
+      if (colour &&
+          red_gain * bgr[x][2] > options_.sky_max_red_over_blue * std::max<int>(bgr[x][0], 1)) {
         continue;
       }
       const Eigen::Vector3d d = rayAt((x + 0.5) * scale - 0.5, (y + 0.5) * scale - 0.5);
@@ -344,6 +377,7 @@ void LalondeEstimator::skyCue(const cv::Mat& work_bgr, const cv::Mat& work_gray,
   sky_rays_.clear();
   sky_luminance_.clear();
   sky_gradation_.clear();
+  sky_cos4_.clear();
   const int stride =
       std::max(1, (fit_count + options_.sky_max_fit_pixels - 1) / options_.sky_max_fit_pixels);
   int k = 0;
@@ -357,6 +391,7 @@ void LalondeEstimator::skyCue(const cv::Mat& work_bgr, const cv::Mat& work_gray,
       sky_rays_.push_back(d);
       sky_luminance_.push_back(srgbToLinear(g[x]));
       sky_gradation_.push_back(perezGradation(perez_, d.dot(cues_.horizon.up_c)));
+      sky_cos4_.push_back(d.z() * d.z() * d.z() * d.z());
     }
   }
   cues_.sky_pixels_fitted = static_cast<int>(sky_rays_.size());
@@ -374,14 +409,26 @@ void LalondeEstimator::skyCue(const cv::Mat& work_bgr, const cv::Mat& work_gray,
     double* out = cues_.sky_loglik.ptr<double>(r);
     for (int c = 0; c < n_az_; ++c) {
       const Eigen::Vector3d& s = cell_directions_[static_cast<std::size_t>(r * n_az_ + c)];
-      double slm = 0.0, smm = 0.0;
+      double slm = 0.0, smm = 0.0, slv = 0.0, smv = 0.0, svv = 0.0;
       for (std::size_t i = 0; i < n; ++i) {
         const double m = sky_gradation_[i] * scattering_(sky_rays_[i].dot(s));
         slm += sky_luminance_[i] * m;
         smm += m * m;
+        if (options_.sky_fit_vignetting) {
+          const double mv = m * sky_cos4_[i];
+          slv += sky_luminance_[i] * mv;
+          smv += m * mv;
+          svv += mv * mv;
+        }
       }
       double rel = 1.0;
       if (smm > 0.0 && slm > 0.0) rel = std::clamp((sum_l2 - slm * slm / smm) / sum_l2, 0.0, 1.0);
+      // Two-basis least squares [m, m c4]: explained energy b' A^-1 b with A the 2x2 Gram matrix.
+      const double det = smm * svv - smv * smv;
+      if (options_.sky_fit_vignetting && smm > 0.0 && det > 1e-12 * smm * svv) {
+        const double explained = (svv * slm * slm - 2.0 * smv * slm * slv + smm * slv * slv) / det;
+        rel = std::clamp((sum_l2 - explained) / sum_l2, 0.0, 1.0);
+      }
       out[c] = -rel * inv_two_sigma2;
     }
   }

@@ -53,14 +53,23 @@ struct LalondeOptions {
   // Sky cue.
   double sky_turbidity = 2.5;  // Perez/Preetham turbidity of the fitted model, [1.7, 10]
   double sky_min_gray = 90.0;  // 8-bit gray a sky pixel must reach, [0, 255]
+  // ... and this share of the image's own bright level (the 99th percentile of the gray above
+  // the horizon): a threshold that follows the exposure and tone curve, [0, 1]
+  double sky_min_relative_gray = 0.9;
   double sky_max_gradient =
       6.0;  // gradient magnitude per px (8-bit units) above = texture, [0.5, 255]
-  double sky_max_red_over_blue = 1.1;  // R / B above = not sky (brick, sunset excluded), [0.5, 5]
+  // R / B above = not sky (brick, sunset excluded), [0.5, 5]; measured after a grey-world white
+  // balance (each channel divided by its image mean) when sky_grey_world is set
+  double sky_max_red_over_blue = 1.1;
+  bool sky_grey_world = false;
   double sky_saturated_gray = 250.0;  // pixels at or above are segmented but not fitted, [128, 255]
   int sky_min_pixels = 150;           // fitted pixels needed for the cue to count, [10, 100000]
   int sky_max_fit_pixels = 400;       // fitted pixels kept (uniform subsample), [50, 100000]
-  double sky_residual_sigma = 0.4;    // relative RMS fit residual worth one sigma, (0, 1]
-  double sky_floor = 0.1;             // chance the sky fit misleads (haze, facades), [0.001, 1)
+  // Fit a free vignetting too: L = k1 m + k2 m cos^4(angle off axis), so that an unknown lens
+  // fall-off (which brightens the image centre like a sun ahead) cannot pose as the sun
+  bool sky_fit_vignetting = false;
+  double sky_residual_sigma = 0.4;     // relative RMS fit residual worth one sigma, (0, 1]
+  double sky_floor = 0.1;              // chance the sky fit misleads (haze, facades), [0.001, 1)
   double sky_min_elevation_deg = 1.0;  // sky pixels lower than this are ignored, deg, [0, 30]
   // Shadow cue.
   double camera_height_m = 1.65;        // camera above the ground plane, m, [0.2, 20] (KITTI)
@@ -152,7 +161,7 @@ class LalondeEstimator final : public sunfusion::ImageSunEstimator {
   cv::Mat work_bgr_, work_gray_, gradient_x_, gradient_y_, blurred_, edges_, ground_mask_, labels_;
   std::vector<cv::Vec4i> hough_lines_;
   std::vector<Eigen::Vector3d> sky_rays_;
-  std::vector<double> sky_luminance_, sky_gradation_;
+  std::vector<double> sky_luminance_, sky_gradation_, sky_cos4_;
   std::vector<Eigen::Vector3d> cell_directions_;
   std::vector<double> shadow_azimuth_;
   std::vector<unsigned char> top_labels_;
