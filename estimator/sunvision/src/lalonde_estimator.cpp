@@ -120,6 +120,24 @@ Status LalondeOptions::validate() const {
   if (!(max_line_weight > 0.0 && max_line_weight <= 1000.0)) {
     return outOfRange("max_line_weight", "(0, 1000]");
   }
+  if (!(wall_side_fraction > 0.0 && wall_side_fraction <= 0.5)) {
+    return outOfRange("wall_side_fraction", "(0, 0.5]");
+  }
+  if (!inRange(wall_min_elevation_deg, 0.0, 45.0)) {
+    return outOfRange("wall_min_elevation_deg", "[0, 45]");
+  }
+  if (!(wall_min_share > 0.0 && wall_min_share <= 1.0)) {
+    return outOfRange("wall_min_share", "(0, 1]");
+  }
+  if (!(wall_log_ratio_scale > 0.0 && wall_log_ratio_scale <= 10.0)) {
+    return outOfRange("wall_log_ratio_scale", "(0, 10]");
+  }
+  if (!(wall_max_weight >= 0.0 && wall_max_weight < 1.0)) {
+    return outOfRange("wall_max_weight", "[0, 1)");
+  }
+  if (!(wall_side_band > 0.0 && wall_side_band <= 1.0)) {
+    return outOfRange("wall_side_band", "(0, 1]");
+  }
   if (!inRange(zenith_prior_mean_deg, 0.0, 90.0)) {
     return outOfRange("zenith_prior_mean_deg", "[0, 90]");
   }
@@ -152,8 +170,8 @@ Status LalondeEstimator::init() {
   n_zen_ = static_cast<int>(std::lround(90.0 / options_.zenith_step_deg));
   perez_ = clearSkyLuminanceParameters(options_.sky_turbidity);
   scattering_.build(perez_);
-  for (cv::Mat* m :
-       {&cues_.sky_loglik, &cues_.shadow_loglik, &cues_.prior_loglik, &cues_.posterior}) {
+  for (cv::Mat* m : {&cues_.sky_loglik, &cues_.shadow_loglik, &cues_.wall_loglik,
+                     &cues_.prior_loglik, &cues_.posterior}) {
     m->create(n_zen_, n_az_, CV_64F);
     m->setTo(0.0);
   }
@@ -244,11 +262,17 @@ Expected<sunfusion::ImageSunEstimate> LalondeEstimator::estimate(
     cues_.shadow_informative = false;
     cues_.shadow_lines.clear();
   }
+  wallCue(work_gray_, scale);
+  if (!options_.use_walls) {
+    cues_.wall_loglik.setTo(0.0);
+    cues_.wall_informative = false;
+  }
   priorCue(input);
 
   // Posterior: sum of the log likelihoods, exponentiated relative to its maximum.
   cv::Mat& post = cues_.posterior;
   cv::add(cues_.sky_loglik, cues_.shadow_loglik, post);
+  cv::add(post, cues_.wall_loglik, post);
   cv::add(post, cues_.prior_loglik, post);
   double max_log = 0.0;
   cv::Point best;
@@ -273,7 +297,7 @@ Expected<sunfusion::ImageSunEstimate> LalondeEstimator::estimate(
   }
 
   sunfusion::ImageSunEstimate out;
-  out.valid = cues_.sky_informative || cues_.shadow_informative;
+  out.valid = cues_.sky_informative || cues_.shadow_informative || cues_.wall_informative;
   out.measurement.kind = sunfusion::SunMeasurementKind::kFull3d;
   out.measurement.sun_c = sun_c;
   out.measurement.sigma =
