@@ -215,6 +215,40 @@ TEST(Lalonde, FreeVignettingFitKeepsTheSunBehindTheCamera) {
   EXPECT_LT(err[1], 10.0);
 }
 
+TEST(Lalonde, WallCueTellsTheLitSide) {
+  // A street canyon: sky in the middle, plain facades on both sides, uniform ground. The sun on
+  // the right lights the left facades (they face right); mirrored, the right ones.
+  const StereoCamera cam = kittiCamera();
+  for (bool sun_right : {true, false}) {
+    cv::Mat img = renderScene(cam, sunInLevelCamera(sun_right ? 70.0 : -70.0, 45.0), true, false);
+    const int side = cam.width / 3, horizon_v = static_cast<int>(cam.cv);
+    const double lit = 170.0, shade = 70.0;
+    img(cv::Rect(0, 0, side, horizon_v)).setTo(cv::Scalar::all(sun_right ? lit : shade));
+    img(cv::Rect(cam.width - side, 0, side, horizon_v))
+        .setTo(cv::Scalar::all(sun_right ? shade : lit));
+    LalondeOptions o;
+    o.use_sky = false;
+    o.use_shadows = false;
+    o.use_walls = true;
+    LalondeEstimator est(o);
+    ASSERT_TRUE(est.init().isOk());
+    Expected<ImageSunEstimate> e = est.estimate({img, cam, SunPrior{}});
+    ASSERT_TRUE(e);
+    EXPECT_TRUE(e->valid);
+    ASSERT_TRUE(est.lastCues().wall_informative);
+    EXPECT_EQ(est.lastCues().wall_log_ratio > 0.0, sun_right);
+    // The cue alone only picks the side: the estimate lies on it.
+    EXPECT_EQ(e->azimuth_deg > 0.0, sun_right) << e->azimuth_deg;
+  }
+  // Off (the default): no wall evidence, and a frame with neither sky nor shadows is invalid.
+  LalondeEstimator off = make(LalondePrior::kZenith);
+  const cv::Mat walls_only(cam.height, cam.width, CV_8UC3, cv::Scalar::all(60));
+  Expected<ImageSunEstimate> e = off.estimate({walls_only, cam, SunPrior{}});
+  ASSERT_TRUE(e);
+  EXPECT_FALSE(off.lastCues().wall_informative);
+  EXPECT_EQ(cv::countNonZero(off.lastCues().wall_loglik != 0.0), 0);
+}
+
 TEST(Lalonde, RejectsBadInput) {
   const StereoCamera cam = kittiCamera();
   LalondeEstimator uninitialised;
@@ -250,6 +284,9 @@ TEST(Lalonde, OptionsNameTheBadKey) {
   o = LalondeOptions{};
   o.canny_high = o.canny_low - 1.0;
   EXPECT_NE(o.validate().message().find("lalonde.canny_high"), std::string::npos);
+  o = LalondeOptions{};
+  o.wall_max_weight = 1.0;
+  EXPECT_NE(o.validate().message().find("lalonde.wall_max_weight"), std::string::npos);
   o = LalondeOptions{};
   o.sky_min_relative_gray = 1.5;
   EXPECT_NE(o.validate().message().find("lalonde.sky_min_relative_gray"), std::string::npos);
