@@ -179,6 +179,36 @@ TEST(Lalonde, SkyMaskFollowsTheImageOwnLevels) {
   }
 }
 
+TEST(Lalonde, TextureWindowKeepsAWindowedFacadeOutOfTheSky) {
+  // A facade as bright as the sky, with a grid of dark windows: the 3x3 gradient test passes
+  // the flat wall between the windows, the mean gradient over a 9 px window does not.
+  const StereoCamera cam = kittiCamera();
+  cv::Mat img = renderScene(cam, sunInLevelCamera(30.0, 45.0), true, false);
+  const int horizon_v = static_cast<int>(cam.cv), wall_w = cam.width / 3;
+  img(cv::Rect(0, 0, wall_w, horizon_v)).setTo(cv::Scalar::all(250));
+  for (int v = 4; v + 12 < horizon_v; v += 24) {
+    for (int u = 4; u + 12 < wall_w; u += 24) {
+      img(cv::Rect(u, v, 12, 12)).setTo(cv::Scalar::all(40));
+    }
+  }
+  for (int window : {0, 9}) {
+    LalondeOptions o;
+    o.sky_texture_window_px = window;
+    o.sky_min_relative_gray = 0.0;  // the wall is as bright as the sky: only texture tells
+    LalondeEstimator est(o);
+    ASSERT_TRUE(est.init().isOk());
+    ASSERT_TRUE(est.estimate({img, cam, SunPrior{}}));
+    const cv::Mat& mask = est.lastCues().sky_mask;
+    const int wall_in_mask = cv::countNonZero(mask.colRange(0, wall_w * mask.cols / cam.width - 2));
+    if (window == 0) {
+      EXPECT_GT(wall_in_mask, 500) << "3x3 gradient only";
+    } else {
+      EXPECT_EQ(wall_in_mask, 0) << "9 px window";
+      EXPECT_TRUE(est.lastCues().sky_informative);
+    }
+  }
+}
+
 TEST(Lalonde, FreeVignettingFitKeepsTheSunBehindTheCamera) {
   // Sun 110 deg right of the optical axis (out of view): the visible sky's only azimuth evidence
   // is a faint left-right slope, which a 30 % cos^4 lens fall-off (the renderer's classic

@@ -252,6 +252,14 @@ void LalondeEstimator::skyCue(const cv::Mat& work_bgr, const cv::Mat& work_gray,
     min_gray = std::max(min_gray, options_.sky_min_relative_gray * p99);
   }
   const float max_grad2 = static_cast<float>(options_.sky_max_gradient * options_.sky_max_gradient);
+  // Texture at a larger scale: the mean gradient magnitude over a window (a facade's window
+  // edges lie within it even where the wall between them is flat).
+  const bool windowed = options_.sky_texture_window_px > 1;
+  if (windowed) {
+    cv::magnitude(gradient_x_, gradient_y_, blurred_);
+    cv::blur(blurred_, blurred_,
+             cv::Size(options_.sky_texture_window_px, options_.sky_texture_window_px));
+  }
   for (int y = 0; y < h; ++y) {
     const unsigned char* g = work_gray.ptr<unsigned char>(y);
     const cv::Vec3b* bgr = work_bgr.ptr<cv::Vec3b>(y);
@@ -261,6 +269,10 @@ void LalondeEstimator::skyCue(const cv::Mat& work_bgr, const cv::Mat& work_gray,
     for (int x = 0; x < w; ++x) {
       if (g[x] < min_gray) continue;
       if (gx[x] * gx[x] + gy[x] * gy[x] > max_grad2) continue;
+      if (windowed &&
+          static_cast<double>(blurred_.at<float>(y, x)) > options_.sky_max_window_gradient) {
+        continue;
+      }
       if (colour &&
           red_gain * bgr[x][2] > options_.sky_max_red_over_blue * std::max<int>(bgr[x][0], 1)) {
         continue;

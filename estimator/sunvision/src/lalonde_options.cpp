@@ -26,6 +26,12 @@ Status LalondeOptions::validate() const {
   if (!inRange(sky_min_relative_gray, 0.0, 1.0)) {
     return outOfRange("sky_min_relative_gray", "[0, 1]");
   }
+  if (sky_texture_window_px < 0 || sky_texture_window_px > 64) {
+    return outOfRange("sky_texture_window_px", "[0, 64]");
+  }
+  if (!inRange(sky_max_window_gradient, 0.1, 255.0)) {
+    return outOfRange("sky_max_window_gradient", "[0.1, 255]");
+  }
   if (!inRange(sky_max_red_over_blue, 0.5, 5.0)) {
     return outOfRange("sky_max_red_over_blue", "[0.5, 5]");
   }

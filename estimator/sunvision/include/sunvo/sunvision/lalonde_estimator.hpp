@@ -72,6 +72,10 @@ struct LalondeOptions {
   // R / B above = not sky (brick, sunset excluded), [0.5, 5]; measured after a grey-world white
   // balance (each channel divided by its image mean) when sky_grey_world is set
   double sky_max_red_over_blue = 1.1;
+  // Mean gradient over a window (window edges of facades), work px, [0, 64]; 0/1 = off (off:
+  // a wash on val, docs/sun_estimators.md)
+  int sky_texture_window_px = 0;
+  double sky_max_window_gradient = 3.0;  // mean gradient per px there, 8-bit units, [0.1, 255]
   bool sky_grey_world = false;
   double sky_saturated_gray = 250.0;  // pixels at or above are segmented but not fitted, [128, 255]
   int sky_min_pixels = 150;           // fitted pixels needed for the cue to count, [10, 100000]
