@@ -41,8 +41,18 @@ class CuesOnARealFrame : public ::testing::Test {
   sunvo::sunvision::LalondeEstimator estimator_;
 };
 
-TEST_F(CuesOnARealFrame, ASunAtTheSkyCuesBestCellHasNoSkyError) {
+TEST_F(CuesOnARealFrame, TheSaturatedSkyIsNotInformative) {
+  // The sky of the KITTI frames is saturated but for a rim: with the relative sky threshold
+  // (0.9 x the 99th percentile gray, 255 here) too few unsaturated pixels remain to fit.
   run({});
+  EXPECT_FALSE(estimator_.lastCues().sky_informative);
+}
+
+TEST_F(CuesOnARealFrame, ASunAtTheSkyCuesBestCellHasNoSkyError) {
+  // The bookkeeping needs an informative sky cue: the absolute threshold alone gives one here.
+  sunvo::sunvision::LalondeOptions o;
+  o.sky_min_relative_gray = 0.0;
+  run(o);
   const sunvo::sunvision::LalondeCues& cues = estimator_.lastCues();
   ASSERT_TRUE(cues.sky_informative);
   cv::Point best;

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <opencv2/imgproc.hpp>
 
@@ -139,6 +140,145 @@ TEST(Lalonde, CuesCanBeSwitchedOff) {
   EXPECT_EQ(cv::countNonZero(est.lastCues().sky_loglik != 0.0), 0);
 }
 
+// sRGB 8-bit <-> linear, to apply lens vignetting in linear light.
+double toLinear(unsigned char v8) {
+  const double v = v8 / 255.0;
+  return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4);
+}
+
+TEST(Lalonde, SkyMaskFollowsTheImageOwnLevels) {
+  // A flat, bright, top-connected wall (a plain facade) at 75 % of the sky's bright level: an
+  // absolute 8-bit threshold takes it for sky, the relative one (share of the image's 99th
+  // percentile above the horizon) does not.
+  const StereoCamera cam = kittiCamera();
+  cv::Mat img = renderScene(cam, sunInLevelCamera(30.0, 45.0), true, false);
+  cv::Mat gray;
+  cv::cvtColor(img, gray, cv::COLOR_BGR2GRAY);
+  const int horizon_v = static_cast<int>(cam.cv);
+  double sky_max = 0.0;
+  cv::minMaxLoc(gray.rowRange(0, horizon_v), nullptr, &sky_max);
+  const double wall = 0.75 * sky_max;
+  ASSERT_GT(wall, LalondeOptions{}.sky_min_gray) << "the wall must pass the absolute threshold";
+  const int wall_w = cam.width / 3;
+  img(cv::Rect(0, 0, wall_w, horizon_v)).setTo(cv::Scalar::all(wall));
+  for (double relative : {0.0, LalondeOptions{}.sky_min_relative_gray}) {
+    LalondeOptions o;
+    o.sky_min_relative_gray = relative;
+    LalondeEstimator est(o);
+    ASSERT_TRUE(est.init().isOk());
+    ASSERT_TRUE(est.estimate({img, cam, SunPrior{}}));
+    const cv::Mat& mask = est.lastCues().sky_mask;  // work resolution
+    const int wall_work = wall_w * mask.cols / cam.width - 2;
+    const int wall_in_mask = cv::countNonZero(mask.colRange(0, wall_work));
+    if (relative == 0.0) {
+      EXPECT_GT(wall_in_mask, 1000) << "absolute threshold only";
+    } else {
+      EXPECT_EQ(wall_in_mask, 0) << "relative threshold";
+      EXPECT_TRUE(est.lastCues().sky_informative);
+    }
+  }
+}
+
+TEST(Lalonde, TextureWindowKeepsAWindowedFacadeOutOfTheSky) {
+  // A facade as bright as the sky, with a grid of dark windows: the 3x3 gradient test passes
+  // the flat wall between the windows, the mean gradient over a 9 px window does not.
+  const StereoCamera cam = kittiCamera();
+  cv::Mat img = renderScene(cam, sunInLevelCamera(30.0, 45.0), true, false);
+  const int horizon_v = static_cast<int>(cam.cv), wall_w = cam.width / 3;
+  img(cv::Rect(0, 0, wall_w, horizon_v)).setTo(cv::Scalar::all(250));
+  for (int v = 4; v + 12 < horizon_v; v += 24) {
+    for (int u = 4; u + 12 < wall_w; u += 24) {
+      img(cv::Rect(u, v, 12, 12)).setTo(cv::Scalar::all(40));
+    }
+  }
+  for (int window : {0, 9}) {
+    LalondeOptions o;
+    o.sky_texture_window_px = window;
+    o.sky_min_relative_gray = 0.0;  // the wall is as bright as the sky: only texture tells
+    LalondeEstimator est(o);
+    ASSERT_TRUE(est.init().isOk());
+    ASSERT_TRUE(est.estimate({img, cam, SunPrior{}}));
+    const cv::Mat& mask = est.lastCues().sky_mask;
+    const int wall_in_mask = cv::countNonZero(mask.colRange(0, wall_w * mask.cols / cam.width - 2));
+    if (window == 0) {
+      EXPECT_GT(wall_in_mask, 500) << "3x3 gradient only";
+    } else {
+      EXPECT_EQ(wall_in_mask, 0) << "9 px window";
+      EXPECT_TRUE(est.lastCues().sky_informative);
+    }
+  }
+}
+
+TEST(Lalonde, FreeVignettingFitKeepsTheSunBehindTheCamera) {
+  // Sun 110 deg right of the optical axis (out of view): the visible sky's only azimuth evidence
+  // is a faint left-right slope, which a 30 % cos^4 lens fall-off (the renderer's classic
+  // camera) overwhelms, pulling a plain fit toward a sun ahead. Fitting the fall-off's strength
+  // as a second linear coefficient removes that pull.
+  const StereoCamera cam = kittiCamera();
+  const double az = 110.0, zen = 45.0;
+  cv::Mat img = renderScene(cam, sunInLevelCamera(az, zen), true, false);
+  for (int v = 0; v < img.rows; ++v) {
+    for (int u = 0; u < img.cols; ++u) {
+      const double c =
+          1.0 / Eigen::Vector3d((u - cam.cu) / cam.fu, (v - cam.cv) / cam.fv, 1.0).norm();
+      const double gain = 2.0 * (1.0 - 0.3 * (1.0 - c * c * c * c));  // exposure x vignetting
+      cv::Vec3b& px = img.at<cv::Vec3b>(v, u);
+      for (int ch = 0; ch < 3; ++ch) px[ch] = testing::toSrgb8(gain * toLinear(px[ch]));
+    }
+  }
+  double err[2] = {0.0, 0.0};
+  for (int fit : {0, 1}) {
+    LalondeOptions o;
+    o.use_shadows = false;
+    o.sky_fit_vignetting = fit == 1;
+    LalondeEstimator est(o);
+    ASSERT_TRUE(est.init().isOk());
+    ASSERT_TRUE(est.estimate({img, cam, SunPrior{}}));
+    ASSERT_TRUE(est.lastCues().sky_informative);
+    cv::Point best;
+    cv::minMaxLoc(est.lastCues().sky_loglik, nullptr, nullptr, nullptr, &best);
+    err[fit] = azimuthErrorDeg(est.azimuthOfColRad(best.x) / kDeg, az);
+  }
+  std::printf("sky cue azimuth error: plain fit %.1f deg, free vignetting %.1f deg\n", err[0],
+              err[1]);
+  EXPECT_GT(err[0], 45.0);
+  EXPECT_LT(err[1], 10.0);
+}
+
+TEST(Lalonde, WallCueTellsTheLitSide) {
+  // A street canyon: sky in the middle, plain facades on both sides, uniform ground. The sun on
+  // the right lights the left facades (they face right); mirrored, the right ones.
+  const StereoCamera cam = kittiCamera();
+  for (bool sun_right : {true, false}) {
+    cv::Mat img = renderScene(cam, sunInLevelCamera(sun_right ? 70.0 : -70.0, 45.0), true, false);
+    const int side = cam.width / 3, horizon_v = static_cast<int>(cam.cv);
+    const double lit = 170.0, shade = 70.0;
+    img(cv::Rect(0, 0, side, horizon_v)).setTo(cv::Scalar::all(sun_right ? lit : shade));
+    img(cv::Rect(cam.width - side, 0, side, horizon_v))
+        .setTo(cv::Scalar::all(sun_right ? shade : lit));
+    LalondeOptions o;
+    o.use_sky = false;
+    o.use_shadows = false;
+    o.use_walls = true;
+    LalondeEstimator est(o);
+    ASSERT_TRUE(est.init().isOk());
+    Expected<ImageSunEstimate> e = est.estimate({img, cam, SunPrior{}});
+    ASSERT_TRUE(e);
+    EXPECT_TRUE(e->valid);
+    ASSERT_TRUE(est.lastCues().wall_informative);
+    EXPECT_EQ(est.lastCues().wall_log_ratio > 0.0, sun_right);
+    // The cue alone only picks the side: the estimate lies on it.
+    EXPECT_EQ(e->azimuth_deg > 0.0, sun_right) << e->azimuth_deg;
+  }
+  // Off (the default): no wall evidence, and a frame with neither sky nor shadows is invalid.
+  LalondeEstimator off = make(LalondePrior::kZenith);
+  const cv::Mat walls_only(cam.height, cam.width, CV_8UC3, cv::Scalar::all(60));
+  Expected<ImageSunEstimate> e = off.estimate({walls_only, cam, SunPrior{}});
+  ASSERT_TRUE(e);
+  EXPECT_FALSE(off.lastCues().wall_informative);
+  EXPECT_EQ(cv::countNonZero(off.lastCues().wall_loglik != 0.0), 0);
+}
+
 TEST(Lalonde, RejectsBadInput) {
   const StereoCamera cam = kittiCamera();
   LalondeEstimator uninitialised;
@@ -174,6 +314,12 @@ TEST(Lalonde, OptionsNameTheBadKey) {
   o = LalondeOptions{};
   o.canny_high = o.canny_low - 1.0;
   EXPECT_NE(o.validate().message().find("lalonde.canny_high"), std::string::npos);
+  o = LalondeOptions{};
+  o.wall_max_weight = 1.0;
+  EXPECT_NE(o.validate().message().find("lalonde.wall_max_weight"), std::string::npos);
+  o = LalondeOptions{};
+  o.sky_min_relative_gray = 1.5;
+  EXPECT_NE(o.validate().message().find("lalonde.sky_min_relative_gray"), std::string::npos);
   o = LalondeOptions{};
   o.vo_sigma_azimuth_deg = 0.0;
   EXPECT_NE(o.validate().message().find("lalonde.vo_sigma_azimuth_deg"), std::string::npos);

@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <numbers>
@@ -12,14 +13,6 @@ namespace sunvo::sunvision {
 namespace {
 constexpr double kPi = std::numbers::pi;
 constexpr double kDeg = kPi / 180.0;
-
-Status outOfRange(const char* key, const char* range) {
-  return invalidArgument(std::string("lalonde.") + key + " out of range " + range);
-}
-
-bool inRange(double v, double lo, double hi) {
-  return v >= lo && v <= hi;
-}
 
 // sRGB 8-bit -> linear [0, 1] (IEC 61966-2-1): the sky fit is done in linear light.
 double srgbToLinear(double v8) {
@@ -63,79 +56,6 @@ double sideBlueShare(const cv::Mat& bgr, const cv::Point2d& a, const cv::Point2d
 }
 }  // namespace
 
-Status LalondeOptions::validate() const {
-  if (!inRange(azimuth_step_deg, 1.0, 15.0)) return outOfRange("azimuth_step_deg", "[1, 15]");
-  if (!inRange(zenith_step_deg, 1.0, 15.0)) return outOfRange("zenith_step_deg", "[1, 15]");
-  if (work_width_px < 160 || work_width_px > 4096) {
-    return outOfRange("work_width_px", "[160, 4096]");
-  }
-  if (!inRange(sky_turbidity, 1.7, 10.0)) return outOfRange("sky_turbidity", "[1.7, 10]");
-  if (!inRange(sky_min_gray, 0.0, 255.0)) return outOfRange("sky_min_gray", "[0, 255]");
-  if (!inRange(sky_max_gradient, 0.5, 255.0)) return outOfRange("sky_max_gradient", "[0.5, 255]");
-  if (!inRange(sky_max_red_over_blue, 0.5, 5.0)) {
-    return outOfRange("sky_max_red_over_blue", "[0.5, 5]");
-  }
-  if (!inRange(sky_saturated_gray, 128.0, 255.0)) {
-    return outOfRange("sky_saturated_gray", "[128, 255]");
-  }
-  if (sky_min_pixels < 10 || sky_min_pixels > 100000) {
-    return outOfRange("sky_min_pixels", "[10, 100000]");
-  }
-  if (sky_max_fit_pixels < 50 || sky_max_fit_pixels > 100000) {
-    return outOfRange("sky_max_fit_pixels", "[50, 100000]");
-  }
-  if (!(sky_residual_sigma > 0.0 && sky_residual_sigma <= 1.0)) {
-    return outOfRange("sky_residual_sigma", "(0, 1]");
-  }
-  if (!inRange(camera_height_m, 0.2, 20.0)) return outOfRange("camera_height_m", "[0.2, 20]");
-  if (!inRange(canny_low, 1.0, 1000.0)) return outOfRange("canny_low", "[1, 1000]");
-  if (!inRange(canny_high, canny_low, 1000.0)) {
-    return outOfRange("canny_high", "[canny_low, 1000]");
-  }
-  if (hough_threshold < 5 || hough_threshold > 1000) {
-    return outOfRange("hough_threshold", "[5, 1000]");
-  }
-  if (!inRange(min_line_length_px, 5.0, 1000.0)) {
-    return outOfRange("min_line_length_px", "[5, 1000]");
-  }
-  if (!inRange(max_ground_distance_m, 2.0, 200.0)) {
-    return outOfRange("max_ground_distance_m", "[2, 200]");
-  }
-  if (!(min_shadow_contrast >= 0.0 && min_shadow_contrast < 1.0)) {
-    return outOfRange("min_shadow_contrast", "[0, 1)");
-  }
-  if (!inRange(shadow_sigma_deg, 1.0, 45.0)) return outOfRange("shadow_sigma_deg", "[1, 45]");
-  if (!(shadow_floor >= 0.01 && shadow_floor < 1.0)) {
-    return outOfRange("shadow_floor", "[0.01, 1)");
-  }
-  if (!(min_shadow_weight > 0.0 && min_shadow_weight <= 1e6)) {
-    return outOfRange("min_shadow_weight", "(0, 1e6]");
-  }
-  if (!inRange(along_track_deg, 0.0, 90.0)) return outOfRange("along_track_deg", "[0, 90]");
-  if (!inRange(along_track_weight, 0.0, 1.0)) return outOfRange("along_track_weight", "[0, 1]");
-  if (!(max_line_weight > 0.0 && max_line_weight <= 1000.0)) {
-    return outOfRange("max_line_weight", "(0, 1000]");
-  }
-  if (!inRange(zenith_prior_mean_deg, 0.0, 90.0)) {
-    return outOfRange("zenith_prior_mean_deg", "[0, 90]");
-  }
-  if (!(zenith_prior_sigma_deg > 0.0 && zenith_prior_sigma_deg <= 180.0)) {
-    return outOfRange("zenith_prior_sigma_deg", "(0, 180]");
-  }
-  if (!(vo_sigma_azimuth_deg > 0.0 && vo_sigma_azimuth_deg <= 360.0)) {
-    return outOfRange("vo_sigma_azimuth_deg", "(0, 360]");
-  }
-  if (!(vo_sigma_zenith_deg > 0.0 && vo_sigma_zenith_deg <= 180.0)) {
-    return outOfRange("vo_sigma_zenith_deg", "(0, 180]");
-  }
-  if (!(min_sigma > 0.0 && min_sigma <= 2.0)) return outOfRange("min_sigma", "(0, 2]");
-  if (!inRange(max_sigma, min_sigma, 2.0)) return outOfRange("max_sigma", "[min_sigma, 2]");
-  if (!(confidence_radius_deg > 0.0 && confidence_radius_deg <= 180.0)) {
-    return outOfRange("confidence_radius_deg", "(0, 180]");
-  }
-  return Status::ok();
-}
-
 LalondeEstimator::LalondeEstimator(const LalondeOptions& options) : options_(options) {}
 
 const char* LalondeEstimator::name() const {
@@ -148,8 +68,8 @@ Status LalondeEstimator::init() {
   n_zen_ = static_cast<int>(std::lround(90.0 / options_.zenith_step_deg));
   perez_ = clearSkyLuminanceParameters(options_.sky_turbidity);
   scattering_.build(perez_);
-  for (cv::Mat* m :
-       {&cues_.sky_loglik, &cues_.shadow_loglik, &cues_.prior_loglik, &cues_.posterior}) {
+  for (cv::Mat* m : {&cues_.sky_loglik, &cues_.shadow_loglik, &cues_.wall_loglik,
+                     &cues_.prior_loglik, &cues_.posterior}) {
     m->create(n_zen_, n_az_, CV_64F);
     m->setTo(0.0);
   }
@@ -240,11 +160,17 @@ Expected<sunfusion::ImageSunEstimate> LalondeEstimator::estimate(
     cues_.shadow_informative = false;
     cues_.shadow_lines.clear();
   }
+  wallCue(work_gray_, scale);
+  if (!options_.use_walls) {
+    cues_.wall_loglik.setTo(0.0);
+    cues_.wall_informative = false;
+  }
   priorCue(input);
 
   // Posterior: sum of the log likelihoods, exponentiated relative to its maximum.
   cv::Mat& post = cues_.posterior;
   cv::add(cues_.sky_loglik, cues_.shadow_loglik, post);
+  cv::add(post, cues_.wall_loglik, post);
   cv::add(post, cues_.prior_loglik, post);
   double max_log = 0.0;
   cv::Point best;
@@ -269,7 +195,7 @@ Expected<sunfusion::ImageSunEstimate> LalondeEstimator::estimate(
   }
 
   sunfusion::ImageSunEstimate out;
-  out.valid = cues_.sky_informative || cues_.shadow_informative;
+  out.valid = cues_.sky_informative || cues_.shadow_informative || cues_.wall_informative;
   out.measurement.kind = sunfusion::SunMeasurementKind::kFull3d;
   out.measurement.sun_c = sun_c;
   out.measurement.sigma =
@@ -297,7 +223,43 @@ void LalondeEstimator::skyCue(const cv::Mat& work_bgr, const cv::Mat& work_gray,
   cues_.sky_mask.create(h, w, CV_8U);
   cues_.sky_mask.setTo(0);
   const double min_up = std::sin(options_.sky_min_elevation_deg * kDeg);
+  // The image's own levels: grey-world channel means (white balance) and the 99th percentile of
+  // the gray above the horizon (exposure and tone curve).
+  double red_gain = 1.0;  // multiplies R / B
+  if (colour && options_.sky_grey_world) {
+    const cv::Scalar mean_bgr = cv::mean(work_bgr);
+    red_gain = std::max(mean_bgr[0], 1.0) / std::max(mean_bgr[2], 1.0);
+  }
+  double min_gray = options_.sky_min_gray;
+  if (options_.sky_min_relative_gray > 0.0) {
+    std::array<int, 256> hist{};
+    int n_above = 0;
+    for (int y = 0; y < h; ++y) {
+      const unsigned char* g = work_gray.ptr<unsigned char>(y);
+      const Eigen::Vector3d d = rayAt((0.5 * w) * scale - 0.5, (y + 0.5) * scale - 0.5);
+      if (d.dot(cues_.horizon.up_c) < min_up) continue;
+      for (int x = 0; x < w; ++x) ++hist[g[x]];
+      n_above += w;
+    }
+    int acc = 0, p99 = 255;
+    for (int v = 255; v >= 0; --v) {
+      acc += hist[static_cast<std::size_t>(v)];
+      if (acc >= n_above / 100 + 1) {
+        p99 = v;
+        break;
+      }
+    }
+    min_gray = std::max(min_gray, options_.sky_min_relative_gray * p99);
+  }
   const float max_grad2 = static_cast<float>(options_.sky_max_gradient * options_.sky_max_gradient);
+  // Texture at a larger scale: the mean gradient magnitude over a window (a facade's window
+  // edges lie within it even where the wall between them is flat).
+  const bool windowed = options_.sky_texture_window_px > 1;
+  if (windowed) {
+    cv::magnitude(gradient_x_, gradient_y_, blurred_);
+    cv::blur(blurred_, blurred_,
+             cv::Size(options_.sky_texture_window_px, options_.sky_texture_window_px));
+  }
   for (int y = 0; y < h; ++y) {
     const unsigned char* g = work_gray.ptr<unsigned char>(y);
     const cv::Vec3b* bgr = work_bgr.ptr<cv::Vec3b>(y);
@@ -305,9 +267,14 @@ void LalondeEstimator::skyCue(const cv::Mat& work_bgr, const cv::Mat& work_gray,
     const float* gy = gradient_y_.ptr<float>(y);
     unsigned char* m = cues_.sky_mask.ptr<unsigned char>(y);
     for (int x = 0; x < w; ++x) {
-      if (g[x] < options_.sky_min_gray) continue;
+      if (g[x] < min_gray) continue;
       if (gx[x] * gx[x] + gy[x] * gy[x] > max_grad2) continue;
-      if (colour && bgr[x][2] > options_.sky_max_red_over_blue * std::max<int>(bgr[x][0], 1)) {
+      if (windowed &&
+          static_cast<double>(blurred_.at<float>(y, x)) > options_.sky_max_window_gradient) {
+        continue;
+      }
+      if (colour &&
+          red_gain * bgr[x][2] > options_.sky_max_red_over_blue * std::max<int>(bgr[x][0], 1)) {
         continue;
       }
       const Eigen::Vector3d d = rayAt((x + 0.5) * scale - 0.5, (y + 0.5) * scale - 0.5);
@@ -344,6 +311,7 @@ void LalondeEstimator::skyCue(const cv::Mat& work_bgr, const cv::Mat& work_gray,
   sky_rays_.clear();
   sky_luminance_.clear();
   sky_gradation_.clear();
+  sky_cos4_.clear();
   const int stride =
       std::max(1, (fit_count + options_.sky_max_fit_pixels - 1) / options_.sky_max_fit_pixels);
   int k = 0;
@@ -357,6 +325,7 @@ void LalondeEstimator::skyCue(const cv::Mat& work_bgr, const cv::Mat& work_gray,
       sky_rays_.push_back(d);
       sky_luminance_.push_back(srgbToLinear(g[x]));
       sky_gradation_.push_back(perezGradation(perez_, d.dot(cues_.horizon.up_c)));
+      sky_cos4_.push_back(d.z() * d.z() * d.z() * d.z());
     }
   }
   cues_.sky_pixels_fitted = static_cast<int>(sky_rays_.size());
@@ -374,14 +343,26 @@ void LalondeEstimator::skyCue(const cv::Mat& work_bgr, const cv::Mat& work_gray,
     double* out = cues_.sky_loglik.ptr<double>(r);
     for (int c = 0; c < n_az_; ++c) {
       const Eigen::Vector3d& s = cell_directions_[static_cast<std::size_t>(r * n_az_ + c)];
-      double slm = 0.0, smm = 0.0;
+      double slm = 0.0, smm = 0.0, slv = 0.0, smv = 0.0, svv = 0.0;
       for (std::size_t i = 0; i < n; ++i) {
         const double m = sky_gradation_[i] * scattering_(sky_rays_[i].dot(s));
         slm += sky_luminance_[i] * m;
         smm += m * m;
+        if (options_.sky_fit_vignetting) {
+          const double mv = m * sky_cos4_[i];
+          slv += sky_luminance_[i] * mv;
+          smv += m * mv;
+          svv += mv * mv;
+        }
       }
       double rel = 1.0;
       if (smm > 0.0 && slm > 0.0) rel = std::clamp((sum_l2 - slm * slm / smm) / sum_l2, 0.0, 1.0);
+      // Two-basis least squares [m, m c4]: explained energy b' A^-1 b with A the 2x2 Gram matrix.
+      const double det = smm * svv - smv * smv;
+      if (options_.sky_fit_vignetting && smm > 0.0 && det > 1e-12 * smm * svv) {
+        const double explained = (svv * slm * slm - 2.0 * smv * slm * slv + smm * slv * slv) / det;
+        rel = std::clamp((sum_l2 - explained) / sum_l2, 0.0, 1.0);
+      }
       out[c] = -rel * inv_two_sigma2;
     }
   }

@@ -18,6 +18,16 @@
 //    along the sun's azimuth, away from the sun, so each line of ground orientation alpha adds
 //    the two-peaked kernel exp(kappa (cos 2(phi - alpha) - 1)) (phi = alpha or alpha + 180 deg);
 //    lines along the camera's forward axis (curbs, markings) are down-weighted;
+//  - wall cue (Lalonde's vertical surfaces, reduced to a street canyon): the facades in the
+//    left part of the image face right (normal +right_c), those in the right part face left. A sun
+//    on the right (sin phi > 0) lights the left facades and leaves the right ones in shadow, so
+//    the log ratio rho = log(median linear gray, left / right) of the non-sky pixels above the
+//    horizon tells the side: q = sigmoid(rho / wall_log_ratio_scale) is the chance the sun is on
+//    the right, w = wall_max_weight (2 q - 1), and log p(phi, theta) = log(1 + w g) with
+//    g = clamp(sin phi sin theta / wall_side_band, -1, 1) (no evidence for a sun straight ahead or
+//    behind, or overhead, where both sides are lit alike; flat elsewhere on each side). The sign of
+//    rho does not depend on the tone curve (medians of a monotone response); its reliability was
+//    measured on the held-out renders (docs/sun_estimators.md);
 //  - prior: Lalonde's zenith prior, a Gaussian over theta (from sun statistics of daytime
 //    photographs), or for Lalonde-VO a Gaussian around the sun predicted from the VO pose,
 //    sigma_az = 60 deg, sigma_zen = 15 deg: the paper chooses them so that the 3-sigma bounds
@@ -45,6 +55,7 @@ struct LalondeOptions {
   LalondePrior prior = LalondePrior::kZenith;
   bool use_sky = true;      // the sky cue (off: for ablation)
   bool use_shadows = true;  // the shadow cue (off: for ablation)
+  bool use_walls = false;   // the wall (lit facade side) cue; off: measured not to help on val
   // Grid.
   double azimuth_step_deg = 3.0;  // deg, [1, 15]; 360 / step cells
   double zenith_step_deg = 3.0;   // deg, [1, 15]; the grid covers zenith [0, 90] deg
@@ -53,14 +64,29 @@ struct LalondeOptions {
   // Sky cue.
   double sky_turbidity = 2.5;  // Perez/Preetham turbidity of the fitted model, [1.7, 10]
   double sky_min_gray = 90.0;  // 8-bit gray a sky pixel must reach, [0, 255]
+  // ... and this share of the image's own bright level (the 99th percentile of the gray above
+  // the horizon): a threshold that follows the exposure and tone curve, [0, 1]
+  double sky_min_relative_gray = 0.9;
   double sky_max_gradient =
       6.0;  // gradient magnitude per px (8-bit units) above = texture, [0.5, 255]
-  double sky_max_red_over_blue = 1.1;  // R / B above = not sky (brick, sunset excluded), [0.5, 5]
+  // R / B above = not sky (brick, sunset excluded), [0.5, 5]; measured after a grey-world white
+  // balance (each channel divided by its image mean) when sky_grey_world is set
+  double sky_max_red_over_blue = 1.1;
+  // Mean gradient over a window (window edges of facades), work px, [0, 64]; 0/1 = off (off:
+  // a wash on val, docs/sun_estimators.md)
+  int sky_texture_window_px = 0;
+  double sky_max_window_gradient = 3.0;  // mean gradient per px there, 8-bit units, [0.1, 255]
+  bool sky_grey_world = false;
   double sky_saturated_gray = 250.0;  // pixels at or above are segmented but not fitted, [128, 255]
   int sky_min_pixels = 150;           // fitted pixels needed for the cue to count, [10, 100000]
   int sky_max_fit_pixels = 400;       // fitted pixels kept (uniform subsample), [50, 100000]
-  double sky_residual_sigma = 0.4;    // relative RMS fit residual worth one sigma, (0, 1]
-  double sky_floor = 0.1;             // chance the sky fit misleads (haze, facades), [0.001, 1)
+  // Fit a free vignetting too: L = k1 m + k2 m cos^4(angle off axis), so that an unknown lens
+  // fall-off (which brightens the image centre like a sun ahead) cannot pose as the sun
+  bool sky_fit_vignetting = false;
+  double sky_residual_sigma = 0.4;  // relative RMS fit residual worth one sigma, (0, 1]
+  // Chance the sky fit misleads (haze, facades, vignetting), [0.001, 1). 0.5: the sky cue alone
+  // is 60-80 % gross on the held-out renders (docs/sun_estimators.md); was 0.1.
+  double sky_floor = 0.5;
   double sky_min_elevation_deg = 1.0;  // sky pixels lower than this are ignored, deg, [0, 30]
   // Shadow cue.
   double camera_height_m = 1.65;        // camera above the ground plane, m, [0.2, 20] (KITTI)
@@ -71,14 +97,23 @@ struct LalondeOptions {
   double max_ground_distance_m = 30.0;  // lines farther away are ignored, m, [2, 200]
   double min_shadow_contrast = 0.4;     // 1 - dark/bright across the edge, [0, 1)
   double shadow_sigma_deg = 10.0;       // angular spread of one line's peaks, deg, [1, 45]
-  double shadow_floor = 0.3;            // share of uniform azimuth mixed in, [0.01, 1)
-  double min_shadow_weight = 2.0;       // sum of line weights (m x contrast) to count, (0, 1e6]
-  double max_line_weight = 5.0;         // cap of one line's weight, m, (0, 1000]
+  // Share of uniform azimuth mixed in, [0.01, 1). 0.9: the shadow cue alone is at chance on the
+  // held-out renders (axial gross 53-62 % where 50 % is chance); was 0.3.
+  double shadow_floor = 0.9;
+  double min_shadow_weight = 2.0;  // sum of line weights (m x contrast) to count, (0, 1e6]
+  double max_line_weight = 5.0;    // cap of one line's weight, m, (0, 1000]
   // Street-aligned lines (curbs, lane markings, facade feet, roof-edge shadows) run along the
   // camera's forward direction in city driving and would pull every estimate to 0/180 deg; a
   // line within along_track_deg of forward counts with this factor. 1 = Lalonde's plain cue.
   double along_track_deg = 10.0;     // deg, [0, 90]
   double along_track_weight = 0.25;  // [0, 1]
+  // Wall cue.
+  double wall_side_fraction = 0.35;     // left / right share of the image width used, (0, 0.5]
+  double wall_min_elevation_deg = 2.0;  // facade pixels at least this above the horizon, [0, 45]
+  double wall_min_share = 0.05;         // share of each side's pixels needed to count, (0, 1]
+  double wall_log_ratio_scale = 0.2;    // rho giving q = sigmoid(1) = 0.73, (0, 10]
+  double wall_max_weight = 0.25;        // |w| at most (the cue's reliability), [0, 1)
+  double wall_side_band = 0.25;         // sin phi sin theta beyond which a side is flat, (0, 1]
   // Priors.
   double zenith_prior_mean_deg = 50.0;   // Lalonde prior, deg, [0, 90]
   double zenith_prior_sigma_deg = 20.0;  // deg, (0, 180]
@@ -103,13 +138,15 @@ struct ShadowLine {
 // cols = azimuth bins from -180 deg; CV_64F; 0 everywhere for a cue that was not informative),
 // the sky mask at the work resolution and the accepted shadow lines.
 struct LalondeCues {
-  cv::Mat sky_loglik, shadow_loglik, prior_loglik, posterior;  // posterior: probabilities, sum 1
-  cv::Mat sky_mask;                                            // CV_8U, 255 = sky
+  cv::Mat sky_loglik, shadow_loglik, wall_loglik, prior_loglik,
+      posterior;     // posterior: probabilities, sum 1
+  cv::Mat sky_mask;  // CV_8U, 255 = sky
   std::vector<ShadowLine> shadow_lines;
   int sky_pixels_segmented = 0;  // at the work resolution
   int sky_pixels_fitted = 0;
   double shadow_weight = 0.0;
-  bool sky_informative = false, shadow_informative = false;
+  double wall_log_ratio = 0.0;  // rho, log(left / right); > 0: the sun on the right
+  bool sky_informative = false, shadow_informative = false, wall_informative = false;
   HorizonFrame horizon;
   int best_row = 0, best_col = 0;
 };
@@ -138,6 +175,7 @@ class LalondeEstimator final : public sunfusion::ImageSunEstimator {
  private:
   void skyCue(const cv::Mat& work_bgr, const cv::Mat& work_gray, bool colour, double scale);
   void shadowCue(const cv::Mat& work_bgr, const cv::Mat& work_gray, bool colour, double scale);
+  void wallCue(const cv::Mat& work_gray, double scale);  // lalonde_walls.cpp
   void priorCue(const sunfusion::ImageSunInput& input);
   Eigen::Vector3d rayAt(double u_full, double v_full) const;
 
@@ -152,10 +190,11 @@ class LalondeEstimator final : public sunfusion::ImageSunEstimator {
   cv::Mat work_bgr_, work_gray_, gradient_x_, gradient_y_, blurred_, edges_, ground_mask_, labels_;
   std::vector<cv::Vec4i> hough_lines_;
   std::vector<Eigen::Vector3d> sky_rays_;
-  std::vector<double> sky_luminance_, sky_gradation_;
+  std::vector<double> sky_luminance_, sky_gradation_, sky_cos4_;
   std::vector<Eigen::Vector3d> cell_directions_;
   std::vector<double> shadow_azimuth_;
   std::vector<unsigned char> top_labels_;
+  std::vector<float> wall_left_, wall_right_;
 };
 
 }  // namespace sunvo::sunvision
