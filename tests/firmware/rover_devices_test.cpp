@@ -173,32 +173,30 @@ TEST(RoverDevices, ALostStrobeIsAMissedTriggerAndItsFrameIsSkipped) {
   EXPECT_EQ(summaryCount(r.summary, "grab errors ([0-9]+)"), 0u);
 }
 
+// The summary's sun line of `provider`: `requests` calls, none of them failed.
+void expectSunCalls(const RunResult& r, const std::string& provider, std::uint64_t requests) {
+  EXPECT_NE(r.summary.find("sun (" + provider + ")"), std::string::npos) << r.summary;
+  const std::string head = "sun \\(" + provider + "\\): requests ";
+  EXPECT_EQ(summaryCount(r.summary, head + "([0-9]+)"), requests);
+  EXPECT_EQ(summaryCount(r.summary, head + "[0-9]+, measurements [0-9]+, errors ([0-9]+)"), 0u);
+}
+
 TEST(RoverDevices, LalondeRunsOnTheGrayFramesOfTheV4l2Cameras) {
   // The V4L2 driver delivers luma only; Lalonde-VO accepts gray, so every fifth frame of 0-19
   // (5, 10, 15) goes to the sun thread and comes back without an error (the textured plane shows no
   // sky or shadows, so whether it yields a measurement is not asserted).
   const RunResult r = runRig(20, -1, "lalonde_vo");
   expectPosesAtStrobes(r);
-  EXPECT_NE(r.summary.find("sun (lalonde_vo)"), std::string::npos) << r.summary;
-  EXPECT_EQ(summaryCount(r.summary, "sun \\(lalonde_vo\\): requests ([0-9]+)"), 3u);
-  EXPECT_EQ(summaryCount(r.summary,
-                         "sun \\(lalonde_vo\\): requests [0-9]+, measurements [0-9]+, "
-                         "errors ([0-9]+)"),
-            0u);
+  expectSunCalls(r, "lalonde_vo", 3);
 }
 
 TEST(RoverDevices, SunCnnRunsOnTheGreyFramesOfTheV4l2Cameras) {
   // The grey model (as config/rover.yaml names it, here from the source tree) on the luma-only
   // V4L2 frames: every fifth frame goes to the sun thread and comes back without an error.
-  const RunResult r = runRig(20, -1, "sun_cnn", "",
-                             std::string(SUNVO_SOURCE_DIR) + "/config/sun_cnn_gray.onnx");
+  const RunResult r =
+      runRig(20, -1, "sun_cnn", "", std::string(SUNVO_SOURCE_DIR) + "/config/sun_cnn_gray.onnx");
   expectPosesAtStrobes(r);
-  EXPECT_NE(r.summary.find("sun (sun_cnn)"), std::string::npos) << r.summary;
-  EXPECT_EQ(summaryCount(r.summary, "sun \\(sun_cnn\\): requests ([0-9]+)"), 3u);
-  EXPECT_EQ(summaryCount(r.summary,
-                         "sun \\(sun_cnn\\): requests [0-9]+, measurements [0-9]+, "
-                         "errors ([0-9]+)"),
-            0u);
+  expectSunCalls(r, "sun_cnn", 3);
 }
 
 TEST(RoverDevices, ThePoseLogHoldsEveryPublishedPoseInTum) {

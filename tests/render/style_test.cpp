@@ -21,6 +21,14 @@ int count(const std::string& text, const std::string& what) {
   return n;
 }
 
+// A small styled city of `blocks` x `blocks` with every hedge and clutter slot filled.
+City styledCity(const StyleOptions& style, int blocks) {
+  DriveLook d = drawDriveLook(style, CityOptions{});
+  d.city.blocks_x = d.city.blocks_y = blocks;
+  d.city_look.hedge_probability = d.city_look.clutter_probability = 1.0;
+  return generateCity(d.city, style.seed, d.city_look);
+}
+
 TEST(Style, SeedZeroIsTheClassicLook) {
   StyleOptions style;
   CityOptions base;
@@ -93,10 +101,7 @@ TEST(Style, HeldOutKindsAreNeverDrawnForTraining) {
 TEST(Style, EveryTextureAStyledCityNamesIsDeclared) {
   for (const char* set : {"train", "heldout"}) {
     const StyleOptions style{7, set, 1};
-    DriveLook d = drawDriveLook(style, CityOptions{});
-    d.city.blocks_x = d.city.blocks_y = 3;
-    d.city_look.hedge_probability = d.city_look.clutter_probability = 1.0;
-    const City city = generateCity(d.city, 7, d.city_look);
+    const City city = styledCity(style, 3);
     const FrameLook f = drawFrameLook(style, 0, SkyOptions{}, SensorOptions{});
     std::set<std::string> names = {city.scene.ground_texture};
     for (const Primitive& p : city.scene.primitives) names.insert(p.texture);
@@ -153,10 +158,7 @@ TEST(Style, SkyKindsRemoveTheAzimuthOrAddClouds) {
 TEST(Style, AStyledFrameRendersThroughPovRay) {
   for (const char* set : {"train", "heldout"}) {
     const StyleOptions style{11, set, 1};
-    DriveLook d = drawDriveLook(style, CityOptions{});
-    d.city.blocks_x = d.city.blocks_y = 2;
-    d.city_look.hedge_probability = d.city_look.clutter_probability = 1.0;
-    const City city = generateCity(d.city, 11, d.city_look);
+    const City city = styledCity(style, 2);
     const FrameLook f = drawFrameLook(style, 0, SkyOptions{}, SensorOptions{});
     Lighting light;
     light.sun_enu = Eigen::Vector3d(0.3, 0.5, 0.8).normalized();
