@@ -97,3 +97,19 @@ def combine(dets, samps):
                    1e-6, 1.0)
     r_al = np.clip(np.linalg.norm(v, axis=1), 1e-6, 1.0)
     return v, np.sqrt(-2 * np.log(r_mc) - 2 * np.log(r_al))
+
+
+def calibrate(err_deg, raw):
+    """The validity threshold and the sigma scale, from validation errors (deg) and raw sigmas
+    (rad). The threshold on raw sigma flags 90 % of the gross (> 45 deg) errors (the 10th
+    percentile of raw sigma over them; with fewer than 5 gross errors no frame is flagged).
+    The scale then makes 95 % of the frames below it fall within 2 sigma, i.e. sigma is
+    calibrated on the frames the estimator calls valid, which are the ones the fusion sees.
+    Returns (scale, threshold on the scaled sigma in rad)."""
+    gross = np.abs(err_deg) > 45
+    tau = np.percentile(raw[gross], 10) if gross.sum() >= 5 else np.inf
+    valid = raw <= tau
+    if valid.sum() < 5:
+        valid = np.ones_like(valid)
+    scale = float(np.percentile(np.radians(np.abs(err_deg[valid])) / raw[valid], 95) / 2.0)
+    return scale, float(min(scale * tau, 3.0))

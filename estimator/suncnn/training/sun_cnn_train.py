@@ -29,7 +29,7 @@ import numpy as np
 import torch
 
 from sun_cnn_model import (DROPOUT_P, FEAT, HIDDEN, IN_H, IN_W, K_ROWS, MEAN, STD, EnsembleExport,
-                           SunCnn, combine, mc_predict)
+                           SunCnn, calibrate, combine, mc_predict)
 
 LOAD_W, LOAD_H = 2 * IN_W, 2 * IN_H  # images are kept at twice the input size for the crops
 LUMA = np.array([0.114, 0.587, 0.299], np.float32)  # BT.601, BGR order
@@ -242,16 +242,12 @@ def main():
     members = [train_member(xtr, ttr, wtr, a, a.seed + m, log) for m in range(a.members)]
     train_s = time.time() - t_train
 
-    # Choices on the validation rows only: the sigma scale (median |err| / sigma = 0.674, as a
-    # Gaussian) and the validity threshold (flag 90 % of the gross errors, at most 0.5 rad).
+    # Choices on the validation rows only: the validity threshold and the sigma scale
+    # (sun_cnn_model.calibrate).
     scale, threshold, results = 1.0, 0.5, {}
     if "val" in data:
         err, raw, scen = evaluate(members, data["val"], a.channels, a.seed)
-        scale = float(np.median(np.radians(np.abs(err)) / raw) / 0.6745)
-        sig = np.clip(scale * raw, 0.03, 3.0)
-        gross = np.abs(err) > 45
-        if gross.sum() >= 5:
-            threshold = float(min(0.5, np.percentile(sig[gross], 10)))
+        scale, threshold = calibrate(err, raw)
         results["val"] = report(err, raw, scen, scale, threshold)
     for split in ("train", "test"):
         if split in data:
