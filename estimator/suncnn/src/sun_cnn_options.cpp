@@ -48,4 +48,10 @@ Expected<SunCnnOptions> loadSunCnnOptions(const std::string& json_path, const Su
   return o;
 }
 
+Expected<SunCnnOptions> optionsForModel(const std::string& model_path) {
+  const std::string json = modelJsonPath(model_path);
+  if (!std::filesystem::exists(json)) return SunCnnOptions{};
+  return loadSunCnnOptions(json);
+}
+
 }  // namespace sunvo::suncnn

@@ -14,8 +14,8 @@ import sys
 import cv2
 import numpy as np
 
-from sun_cnn_model import DROPOUT_P, IN_H, IN_W, calibrate, combine
-from sun_cnn_train import load, report, signed_deg, targets
+from sun_cnn_model import DROPOUT_P, IN_H, IN_W, MEAN, STD, calibrate, combine
+from sun_cnn_train import LUMA, load, report, signed_deg, targets
 
 SAMPLES = 16
 
@@ -30,8 +30,8 @@ def run_model(net, meta, images, rng):
     for i, img in enumerate(images):
         small = cv2.resize(img, (IN_W, IN_H), interpolation=cv2.INTER_AREA).astype(np.float32)
         if ch == 1:
-            small = (small @ np.array([0.114, 0.587, 0.299], np.float32))[..., None]
-        blob = ((small / 255.0 - 0.5) / 0.25).transpose(2, 0, 1)[None].copy()
+            small = (small @ LUMA)[..., None]
+        blob = ((small / 255.0 - MEAN) / STD).transpose(2, 0, 1)[None].copy()
         m1 = np.ones((rows, f), np.float32)
         m2 = np.ones((rows, d), np.float32)
         m1[1:SAMPLES + 1] = (rng.random((SAMPLES, f)) >= DROPOUT_P) * keep

@@ -1,7 +1,5 @@
 #include "sunvo/sunestimators/sun_estimators.hpp"
 
-#include <filesystem>
-
 #include "sunvo/suncnn/sun_cnn_estimator.hpp"
 #include "sunvo/sunvision/lalonde_estimator.hpp"
 
@@ -18,15 +16,10 @@ Expected<std::unique_ptr<sunfusion::ImageSunEstimator>> lalonde(sunvision::Lalon
 Expected<std::unique_ptr<sunfusion::ImageSunEstimator>> sunCnn(const std::string& model_path) {
   // The model's JSON (written with it by the training script) says its channels, ensemble and
   // calibration; without one, the defaults (the shipped colour model's) apply.
-  suncnn::SunCnnOptions options;
-  const std::string json = suncnn::modelJsonPath(model_path);
-  if (std::filesystem::exists(json)) {
-    auto o = suncnn::loadSunCnnOptions(json);
-    if (!o) return o.status();
-    options = *o;
-  }
+  auto options = suncnn::optionsForModel(model_path);
+  if (!options) return options.status();
   auto e = std::make_unique<suncnn::SunCnnEstimator>();
-  SUNVO_RETURN_IF_ERROR(e->init(options, model_path));
+  SUNVO_RETURN_IF_ERROR(e->init(*options, model_path));
   return std::unique_ptr<sunfusion::ImageSunEstimator>(std::move(e));
 }
 }  // namespace

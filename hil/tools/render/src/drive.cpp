@@ -1,7 +1,5 @@
 #include "sunvo/render/drive.hpp"
 
-#include <yaml-cpp/yaml.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -10,8 +8,6 @@
 #include <numbers>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <set>
-#include <sstream>
 
 #include "sunvo/kitti/oxts.hpp"
 #include "sunvo/kitti/timestamps.hpp"

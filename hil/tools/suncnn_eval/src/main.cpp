@@ -124,13 +124,9 @@ int main(int argc, char** argv) {
                  kProgram);
     return sunvo::cli::kExitUsage;
   }
-  sunvo::suncnn::SunCnnOptions options;
-  const std::string json = sunvo::suncnn::modelJsonPath(model);
-  if (std::filesystem::exists(json)) {
-    auto o = sunvo::suncnn::loadSunCnnOptions(json);
-    if (!o) return sunvo::cli::fail(kProgram, o.status());
-    options = *o;
-  }
+  auto model_options = sunvo::suncnn::optionsForModel(model);
+  if (!model_options) return sunvo::cli::fail(kProgram, model_options.status());
+  sunvo::suncnn::SunCnnOptions options = *model_options;
   if (mc) options.mc_samples = *mc;
   if (sigma_scale) options.sigma_scale = *sigma_scale;
   if (const Status st = options.validate(); !st.isOk()) {

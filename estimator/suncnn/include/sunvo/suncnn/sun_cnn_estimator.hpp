@@ -74,6 +74,9 @@ Expected<SunCnnOptions> loadSunCnnOptions(const std::string& json_path,
                                           const SunCnnOptions& base = {});
 // "dir/name.onnx" -> "dir/name.json".
 std::string modelJsonPath(const std::string& model_path);
+// The options of the model at model_path: its JSON's when there is one beside it, else the
+// defaults (the shipped colour model's).
+Expected<SunCnnOptions> optionsForModel(const std::string& model_path);
 
 // The raw network answer for one image, before the uncertainty is turned into a measurement.
 struct SunCnnRaw {
