@@ -99,6 +99,13 @@ Status BundleWindow::init(const WindowOptions& options, const StereoCamera& came
   }
   quaternion_manifold_ = std::make_unique<ceres::EigenQuaternionManifold>();
 
+  const int max_generic = static_cast<int>(residual_ids_.size()) - static_cast<int>(n_pool);
+  SUNVO_RETURN_IF_ERROR(schur_.init(static_cast<int>(n_pool), options.max_landmarks, max_generic));
+  if (options.solver != WindowSolver::kCeres) {
+    initialized_ = true;
+    reset(Isometry3::Identity());
+    return Status::ok();
+  }
   ceres::Problem::Options po;
   po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -128,8 +135,8 @@ void BundleWindow::reset(const Isometry3& T_w_b) {
 
 void BundleWindow::setSolverTimeBudget(double seconds) {
   const double configured = options_.max_solver_time_in_seconds;
-  time_budget_s_ = std::isfinite(seconds) && seconds > 0.0 ? std::min(seconds, configured)
-                                                            : configured;
+  time_budget_s_ =
+      std::isfinite(seconds) && seconds > 0.0 ? std::min(seconds, configured) : configured;
 }
 
 void BundleWindow::setPose(int slot, const Isometry3& T_k_b) {
@@ -206,6 +213,11 @@ Status BundleWindow::addFrame(std::uint64_t sequence, TimeNs time_ns,
 }
 
 void BundleWindow::clearResiduals() {
+  num_extra_ = 0;
+  if (!problem_) {
+    num_residuals_ = 0;
+    return;
+  }
   for (int i = 0; i < num_residuals_; ++i) {
     problem_->RemoveResidualBlock(residual_ids_[static_cast<std::size_t>(i)]);
   }
@@ -227,6 +239,13 @@ Status BundleWindow::addPoseResidual(int slot, ceres::CostFunction* cost,
   if (num_residuals_ >= static_cast<int>(residual_ids_.size())) {
     return invalidArgument("window: too many extra pose residuals");
   }
+  if (!problem_) {
+    const SchurLmSolver::BlockRef block{SchurLmSolver::BlockRef::Kind::kRotation, slot, nullptr};
+    SUNVO_RETURN_IF_ERROR(schur_.addGeneric(cost, loss, {&block, 1}));
+    ++num_residuals_;
+    ++num_extra_;
+    return Status::ok();
+  }
   residual_ids_[static_cast<std::size_t>(num_residuals_++)] =
       problem_->AddResidualBlock(cost, loss, poses_[static_cast<std::size_t>(slot)].q.data());
   ++num_extra_;
@@ -247,6 +266,16 @@ Status BundleWindow::addResidual(int slot, ceres::CostFunction* cost, ceres::Los
   }
   if (num_residuals_ >= static_cast<int>(residual_ids_.size())) {
     return invalidArgument("window: too many extra residuals");
+  }
+  if (!problem_) {
+    std::array<SchurLmSolver::BlockRef, 4> refs{};
+    std::size_t k = 0;
+    if (slot > 0) refs[k++] = {SchurLmSolver::BlockRef::Kind::kRotation, slot, nullptr};
+    for (double* b : extra_blocks) refs[k++] = {SchurLmSolver::BlockRef::Kind::kExtra, 0, b};
+    SUNVO_RETURN_IF_ERROR(schur_.addGeneric(cost, loss, {refs.data(), k}));
+    ++num_residuals_;
+    ++num_extra_;
+    return Status::ok();
   }
   std::array<double*, 4> blocks{};
   std::size_t i = 0;
@@ -283,6 +312,16 @@ Expected<WindowSolveSummary> BundleWindow::solve() {
   });
 
   WindowSolveSummary out;
+  const bool use_ceres = problem_ != nullptr;
+  if (!use_ceres) {
+    std::array<double*, kMaxWindowSize> q{};
+    std::array<double*, kMaxWindowSize> t{};
+    for (int s = 0; s < size_; ++s) {
+      q[static_cast<std::size_t>(s)] = poses_[static_cast<std::size_t>(s)].q.data();
+      t[static_cast<std::size_t>(s)] = poses_[static_cast<std::size_t>(s)].t.data();
+    }
+    SUNVO_RETURN_IF_ERROR(schur_.begin(size_, q, t));
+  }
   int n_landmarks = 0;
   int n_stereo = 0;
   for (auto g = begin; g != end;) {
@@ -311,10 +350,15 @@ Expected<WindowSolveSummary> BundleWindow::solve() {
       if (have) {
         auto& l = landmarks_[static_cast<std::size_t>(n_landmarks++)];
         l = {p_b.x(), p_b.y(), p_b.z()};
+        if (!use_ceres) SUNVO_RETURN_IF_ERROR(schur_.addLandmark(l.data()));
         for (auto e = g; e != g_end; ++e) {
           const auto r = static_cast<std::size_t>(n_stereo++);
           measurements_[r] =
               frames_[static_cast<std::size_t>(e->slot)].obs[static_cast<std::size_t>(e->obs)].y;
+          if (!use_ceres) {
+            SUNVO_RETURN_IF_ERROR(schur_.addStereo(e->slot, cost_pool_[r].get(), loss_.get()));
+            continue;
+          }
           PoseBlock& p = poses_[static_cast<std::size_t>(e->slot)];
           residual_ids_[static_cast<std::size_t>(num_residuals_++)] = problem_->AddResidualBlock(
               cost_pool_[r].get(), loss_.get(), p.q.data(), p.t.data(), l.data());
@@ -335,10 +379,20 @@ Expected<WindowSolveSummary> BundleWindow::solve() {
   for (int s = 1; s < size_; ++s) {
     const auto us = static_cast<std::size_t>(s);
     if (!frames_[us].has_prior) continue;
+    ++out.num_prior_residuals;
+    if (!use_ceres) {
+      using Kind = SchurLmSolver::BlockRef::Kind;
+      const SchurLmSolver::BlockRef refs[] = {{Kind::kRotation, s - 1, nullptr},
+                                              {Kind::kTranslation, s - 1, nullptr},
+                                              {Kind::kRotation, s, nullptr},
+                                              {Kind::kTranslation, s, nullptr}};
+      SUNVO_RETURN_IF_ERROR(schur_.addGeneric(prior_pool_[us].get(), nullptr, refs));
+      ++num_residuals_;
+      continue;
+    }
     residual_ids_[static_cast<std::size_t>(num_residuals_++)] = problem_->AddResidualBlock(
         prior_pool_[us].get(), nullptr, poses_[us - 1].q.data(), poses_[us - 1].t.data(),
         poses_[us].q.data(), poses_[us].t.data());
-    ++out.num_prior_residuals;
   }
 
   saved_poses_ = poses_;
@@ -350,6 +404,8 @@ Expected<WindowSolveSummary> BundleWindow::solve() {
   }
   out.num_extra_residuals = num_extra_;
 
+  if (!use_ceres) return solveSchur(out);
+
   ceres::Solver::Options so;
   so.linear_solver_type = ceres::DENSE_SCHUR;
   so.num_threads = 1;
@@ -360,18 +416,7 @@ Expected<WindowSolveSummary> BundleWindow::solve() {
   ceres::Solver::Summary summary;
   ceres::Solve(so, problem_.get(), &summary);
 
-  bool finite = true;
-  for (int s = 1; s < size_; ++s) {
-    PoseBlock& p = poses_[static_cast<std::size_t>(s)];
-    Eigen::Map<Eigen::Quaterniond> q(p.q.data());
-    const double n = q.norm();
-    if (!std::isfinite(n) || n < 1e-6 || !std::isfinite(p.t[0]) || !std::isfinite(p.t[1]) ||
-        !std::isfinite(p.t[2])) {
-      finite = false;
-      break;
-    }
-    q.normalize();
-  }
+  const bool finite = normalizePoses();
   if (!summary.IsSolutionUsable() || !finite) {
     poses_ = saved_poses_;
     return failedPrecondition("window: solver result unusable: " + summary.message);
@@ -383,6 +428,39 @@ Expected<WindowSolveSummary> BundleWindow::solve() {
   out.converged = summary.termination_type == ceres::CONVERGENCE;
   if (post_hook_) post_hook_(*this);
   return out;
+}
+
+Expected<WindowSolveSummary> BundleWindow::solveSchur(WindowSolveSummary out) {
+  SchurLmSolver::Options so;
+  so.max_iterations = options_.max_num_iterations;
+  so.max_time_s = time_budget_s_;
+  const Expected<SchurLmSummary> r = schur_.solve(so);
+  if (!r.hasValue() || !normalizePoses()) {
+    poses_ = saved_poses_;
+    return failedPrecondition(std::string("window: solver result unusable") +
+                              (r.hasValue() ? "" : ": " + r.status().message()));
+  }
+  out.iterations = r->iterations;
+  out.solver_time_s = r->time_s;
+  out.initial_cost = r->initial_cost;
+  out.final_cost = r->final_cost;
+  out.converged = r->converged;
+  if (post_hook_) post_hook_(*this);
+  return out;
+}
+
+bool BundleWindow::normalizePoses() {
+  for (int s = 1; s < size_; ++s) {
+    PoseBlock& p = poses_[static_cast<std::size_t>(s)];
+    Eigen::Map<Eigen::Quaterniond> q(p.q.data());
+    const double n = q.norm();
+    if (!std::isfinite(n) || n < 1e-6 || !std::isfinite(p.t[0]) || !std::isfinite(p.t[1]) ||
+        !std::isfinite(p.t[2])) {
+      return false;
+    }
+    q.normalize();
+  }
+  return true;
 }
 
 }  // namespace sunvo::backend

@@ -1,14 +1,16 @@
 // Full image VO benchmark on real KITTI images: StereoImageOdometry (front end + 3-point RANSAC +
-// Ceres window) on the 11 frames of 00_first_frames played forward and backward (0..10..0..),
+// two-frame window) on the 11 frames of 00_first_frames played forward and backward (0..10..0..),
 // single-threaded (cv::setNumThreads(0); the pipeline starts no threads). Prints per-stage wall
 // time median/p95/p99/max, heap allocations per frame per stage in steady state, the resident set
 // size after warm-up and at the end, and measured/target ratios (targets: 20 ms median, 35 ms p99
 // per frame).
 //
-// Two runs over the same frames: "full" (the default pipeline) and "ransac_only"
-// (vo.use_window = false). The front end is deterministic and RANSAC is seeded per frame, so the
-// back end of the second run makes the same association + RANSAC calls: its allocations are
-// RANSAC's, and the window's are the full run's back-end allocations minus those.
+// Three runs over the same frames: "full" (the default pipeline, window solved by the
+// fixed-memory Schur LM), "full_ceres" (the same with window.solver = ceres, the baseline of the
+// ratio rows) and "ransac_only" (vo.use_window = false). The front end is deterministic and RANSAC
+// is seeded per frame, so the back end of the second run makes the same association + RANSAC calls:
+// its allocations are RANSAC's, and the window's are the full run's back-end allocations minus
+// those.
 //
 // A third run times the back end alone (vo::StereoTrackOdometry, track mode) on the real feature
 // tracks of KITTI 2011_09_30_drive_0020 (1000 frames, SURF+KLT tracks, ~65 observations per frame).
@@ -71,13 +73,16 @@ struct Run {
 Config g_config;
 sunvo::bench::KittiFrames g_data;
 Run g_full;
+Run g_full_ceres;
 Run g_ransac_only;
 Run g_tracks;
 sunvo::files::TrackSequence g_track_seq;
 
-void runPipeline(benchmark::State& state, bool use_window, Run& r) {
+void runPipeline(benchmark::State& state, bool use_window, sunvo::backend::WindowSolver solver,
+                 Run& r) {
   sunvo::pipeline::PipelineOptions opt;
   opt.vo.use_window = use_window;
+  opt.vo.window.solver = solver;
   sunvo::pipeline::StereoImageOdometry vo;
   const sunvo::Status st = vo.init(opt, g_data.camera);
   if (!st.isOk()) {
@@ -234,10 +239,13 @@ void benchTracks(benchmark::State& state) {
 }
 
 void benchFull(benchmark::State& state) {
-  runPipeline(state, true, g_full);
+  runPipeline(state, true, sunvo::backend::WindowSolver::kSchurLm, g_full);
+}
+void benchFullCeres(benchmark::State& state) {
+  runPipeline(state, true, sunvo::backend::WindowSolver::kCeres, g_full_ceres);
 }
 void benchRansacOnly(benchmark::State& state) {
-  runPipeline(state, false, g_ransac_only);
+  runPipeline(state, false, sunvo::backend::WindowSolver::kSchurLm, g_ransac_only);
 }
 
 double mean(const std::vector<double>& v) {
@@ -262,8 +270,8 @@ void printRun(const Run& r) {
   row("front end: match (temporal+stereo)", r.match_ms);
   row("front end: process() total", r.frontend_ms);
   row("back end: association + RANSAC", r.ransac_ms);
-  row("back end: window + Ceres", r.window_ms);
-  row("  of which Ceres Solve() (own timer)", r.ceres_ms);
+  row("back end: window (gather + solve)", r.window_ms);
+  row("  of which the solver (own timer)", r.ceres_ms);
   row("back end: process() total", r.odometry_ms);
   row("pipeline: process() total", r.total_ms);
   row("pipeline: outer wall (incl. call)", r.outer_ms);
@@ -283,7 +291,7 @@ void printRun(const Run& r) {
       "circular-tracked median %.0f, RANSAC inliers median %.0f (min %.0f)\n",
       r.tracking, r.recovered, r.lost, percentile(r.features, 0.5), percentile(r.tracked, 0.5),
       percentile(r.inliers, 0.5), percentile(r.inliers, 0.0));
-  std::printf("window landmarks median %.0f (max %.0f), Ceres iterations median %.0f (max %.0f)\n",
+  std::printf("window landmarks median %.0f (max %.0f), solver iterations median %.0f (max %.0f)\n",
               percentile(r.landmarks, 0.5), percentile(r.landmarks, 1.0),
               percentile(r.iterations, 0.5), percentile(r.iterations, 1.0));
   std::printf(
@@ -299,14 +307,14 @@ void printTracks(const Run& r) {
   std::printf("%-36s %9s %9s %9s %9s %9s\n", "wall time per frame [ms]", "median", "p95", "p99",
               "max", "mean");
   row("association + RANSAC", r.ransac_ms);
-  row("window + Ceres", r.window_ms);
-  row("  of which Ceres Solve() (own timer)", r.ceres_ms);
+  row("window (gather + solve)", r.window_ms);
+  row("  of which the solver (own timer)", r.ceres_ms);
   row("StereoTrackOdometry::process() total", r.odometry_ms);
   row("thread CPU time", r.cpu_ms);
   row("heap allocations per frame", r.alloc_odometry);
   std::printf(
       "status: %d tracking, %d recovered, %d lost; RANSAC inliers median %.0f, window "
-      "landmarks median %.0f, Ceres iterations median %.0f\n",
+      "landmarks median %.0f, solver iterations median %.0f\n",
       r.tracking, r.recovered, r.lost, percentile(r.inliers, 0.5), percentile(r.landmarks, 0.5),
       percentile(r.iterations, 0.5));
   std::printf(
@@ -332,8 +340,25 @@ void printSummary() {
                 percentile(g_full.alloc_frontend, 1.0));
     std::printf("  association + RANSAC      %10.2f (max %.0f)   [ransac_only run]\n", ransac,
                 percentile(g_ransac_only.alloc_odometry, 1.0));
-    std::printf("  window + Ceres            %10.2f             [full - ransac_only]\n",
+    std::printf("  window                    %10.2f             [full - ransac_only]\n",
                 backend - ransac);
+  }
+  if (g_full_ceres.ok) {
+    printRun(g_full_ceres);
+    const auto ratio = [](const char* what, const std::vector<double>& a,
+                          const std::vector<double>& b) {
+      std::printf("  %-34s median %8.3f / %8.3f = %.3f   p99 %8.3f / %8.3f = %.3f\n", what,
+                  percentile(a, 0.5), percentile(b, 0.5), percentile(a, 0.5) / percentile(b, 0.5),
+                  percentile(a, 0.99), percentile(b, 0.99),
+                  percentile(a, 0.99) / percentile(b, 0.99));
+    };
+    std::printf("\nschur_lm (full) against the ceres baseline (full_ceres), same frames:\n");
+    ratio("window wall time [ms]", g_full.window_ms, g_full_ceres.window_ms);
+    ratio("back end thread CPU [ms]", g_full.odometry_cpu_ms, g_full_ceres.odometry_cpu_ms);
+    ratio("pipeline thread CPU [ms]", g_full.cpu_ms, g_full_ceres.cpu_ms);
+    ratio("pipeline wall time [ms]", g_full.total_ms, g_full_ceres.total_ms);
+    std::printf("  %-34s mean %10.2f / %10.2f\n", "back-end heap allocations per frame",
+                mean(g_full.alloc_odometry), mean(g_full_ceres.alloc_odometry));
   }
   if (g_tracks.ok) printTracks(g_tracks);
   const double p50 = percentile(g_full.total_ms, 0.5);
@@ -356,7 +381,7 @@ int main(int argc, char** argv) {
   constexpr const char* kProgram = "sunvo_bench_vo";
   cv::setNumThreads(0);
   CLI::App app{
-      "Image VO (front end, RANSAC, Ceres window) time and heap allocations per frame on real "
+      "Image VO (front end, RANSAC, window) time and heap allocations per frame on real "
       "KITTI frames, and the back end alone on recorded feature tracks.",
       kProgram};
   sunvo::bench::addBenchOptions(app, g_config);
@@ -368,8 +393,13 @@ int main(int argc, char** argv) {
   if (!data) return sunvo::cli::fail(kProgram, data.status());
   g_data = std::move(*data);
   g_full.name = "full";
+  g_full_ceres.name = "full_ceres";
   g_ransac_only.name = "ransac_only";
   benchmark::RegisterBenchmark("vo/full/kitti00_first_frames_pingpong", benchFull)
+      ->Iterations(g_config.frames)
+      ->Unit(benchmark::kMillisecond)
+      ->UseRealTime();
+  benchmark::RegisterBenchmark("vo/full_ceres/kitti00_first_frames_pingpong", benchFullCeres)
       ->Iterations(g_config.frames)
       ->Unit(benchmark::kMillisecond)
       ->UseRealTime();

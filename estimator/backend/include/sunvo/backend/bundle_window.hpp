@@ -1,19 +1,18 @@
 #pragma once
-// A bounded sliding window of N stereo poses solved with Ceres (the paper's back end).
+// A bounded sliding window of N stereo poses (the paper's back end).
 //
 // The window holds the last N frames (N = window_size, default 2). Its base frame b is the oldest
 // frame; the base's world pose T_w_b is fixed (it came from the previous windows). Unknowns: the
-// other poses T_k_b (unit quaternion with ceres::EigenQuaternionManifold + translation) and the
-// positions p_b of the landmarks seen in at least two window frames, initialised by stereo
-// triangulation in the first frame that sees them with enough disparity.
+// other poses T_k_b (unit quaternion, local update as ceres::EigenQuaternionManifold, +
+// translation) and the positions p_b of the landmarks seen in at least two window frames,
+// initialised by stereo triangulation in the first frame that sees them with enough disparity.
 //
-// Memory: everything is sized in init(). The ceres::Problem lives as long as the window and is
-// created with enable_fast_removal; its pose blocks (one per window slot) and landmark blocks (one
-// per landmark slot, max_landmarks) point into fixed arrays and are added once in init(); unused
-// landmark blocks have no residuals and Ceres drops them from the reduced program. Each solve()
-// removes the previous residual blocks and adds the new ones, using a pool of stereo cost functions
-// (created once, DO_NOT_TAKE_OWNERSHIP) bound to fixed measurement slots. Nothing grows with the
-// run length; the only per-solve allocations are Ceres' own bounded bookkeeping.
+// Memory: everything is sized in init(); nothing grows with the run length. The default solver
+// (WindowSolver::kSchurLm, schur_lm_solver.hpp) keeps its buffers from init() and allocates nothing
+// per solve. The reference solver (kCeres) keeps a ceres::Problem for the window's life (fast
+// removal, pose and landmark blocks added once); each solve() removes the previous residual
+// blocks and adds the new ones from a pool of stereo cost functions bound to fixed measurement
+// slots, and ceres::Solve allocates its own bookkeeping per call.
 //
 // Extension hook: a caller may add one more residual type per pose (e.g. an absolute direction,
 // the sun: s_hat_k = C_k_b C_b_w s_w) through setPoseResidualHook(); the hook is called in solve()
@@ -32,6 +31,7 @@
 #include <string_view>
 #include <vector>
 
+#include "sunvo/backend/schur_lm_solver.hpp"
 #include "sunvo/backend/stereo_residual.hpp"
 #include "sunvo/core/camera.hpp"
 #include "sunvo/core/geometry.hpp"
@@ -39,6 +39,14 @@
 #include "sunvo/core/time.hpp"
 
 namespace sunvo::backend {
+
+// Which solver minimises the window: the fixed-memory Schur-complement Levenberg-Marquardt of
+// schur_lm_solver.hpp (no heap allocation per solve), or ceres::Solve (DENSE_SCHUR), the reference.
+enum class WindowSolver { kSchurLm, kCeres };
+inline std::span<const std::string_view> enumNames(WindowSolver) {
+  static constexpr std::string_view kNames[] = {"schur_lm", "ceres"};
+  return kNames;
+}
 
 enum class RobustLoss { kNone, kHuber, kCauchy };
 inline std::span<const std::string_view> enumNames(RobustLoss) {
@@ -56,8 +64,9 @@ struct WindowOptions {
   RobustLoss loss = RobustLoss::kCauchy;  // robust loss on the whitened residual
   double loss_scale = 2.0;                // whitened units (sigmas), > 0: Huber/Cauchy scale
   double min_disparity_px = 1.0;  // px, > 0: smallest disparity used to triangulate a landmark
-  int max_num_iterations = 10;    // count, [1, 1000]: Ceres iterations per solve
-  double max_solver_time_in_seconds = 0.05;  // s, > 0: Ceres time limit per solve
+  WindowSolver solver = WindowSolver::kSchurLm;  // schur_lm | ceres
+  int max_num_iterations = 10;                   // count, [1, 1000]: solver iterations per solve
+  double max_solver_time_in_seconds = 0.05;      // s, > 0: solver time limit per solve
   // Soft prior on each frame's motion relative to the previous window frame, when addFrame() is
   // given a predicted motion (e.g. constant velocity). 0 disables it.
   double motion_prior_sigma_rot_deg = 0.0;  // deg, >= 0: std of the rotation deviation
@@ -75,6 +84,7 @@ struct WindowOptions {
     v("loss", s.loss);
     v("loss_scale", s.loss_scale);
     v("min_disparity_px", s.min_disparity_px);
+    v("solver", s.solver);
     v("max_num_iterations", s.max_num_iterations);
     v("max_solver_time_in_seconds", s.max_solver_time_in_seconds);
     v("motion_prior_sigma_rot_deg", s.motion_prior_sigma_rot_deg);
@@ -97,7 +107,7 @@ struct WindowSolveSummary {
   double solver_time_s = 0.0;
   double initial_cost = 0.0;
   double final_cost = 0.0;
-  bool converged = false;  // Ceres reported CONVERGENCE (else NO_CONVERGENCE / time limit)
+  bool converged = false;  // a tolerance was met (else the iteration or time limit ended it)
 };
 
 class BundleWindow {
@@ -188,6 +198,9 @@ class BundleWindow {
   };
 
   void setPose(int slot, const Isometry3& T_k_b);
+  Expected<WindowSolveSummary> solveSchur(WindowSolveSummary out);
+  // Normalises the quaternions of slots 1..; false when a pose is not finite.
+  bool normalizePoses();
   void clearResiduals();
 
   WindowOptions options_;
@@ -209,7 +222,8 @@ class BundleWindow {
   int num_residuals_ = 0;
   std::unique_ptr<ceres::LossFunction> loss_;
   std::unique_ptr<ceres::Manifold> quaternion_manifold_;
-  std::unique_ptr<ceres::Problem> problem_;
+  std::unique_ptr<ceres::Problem> problem_;  // solver == kCeres only
+  SchurLmSolver schur_;                      // solver == kSchurLm only
   PoseResidualHook hook_;
   PostSolveHook post_hook_;
   bool in_hook_ = false;
