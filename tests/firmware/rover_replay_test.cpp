@@ -339,5 +339,36 @@ TEST(RoverReplay, BadImagesAreDroppedCountedAndAPersistentFaultStops) {
   EXPECT_NE(stopped.summary.find("capture stopped, the source fault persisted"), std::string::npos);
 }
 
+// Random faults at the capture seams (source.faults): every injected fault shows in the health
+// counter that must account for it, poses keep coming, none is NaN, and VO ends near the truth.
+TEST(RoverReplay, RandomFaultsAreCountedByTheHealthCounters) {
+  int frames = 0;
+  const std::string rendered = findOrRenderDrive(&frames);
+  ASSERT_FALSE(rendered.empty()) << "no rendered drive";
+  frames = std::min(frames, 60);
+  const InProcessRun run =
+      runInProcess(rendered, {{"source.kitti.last_frame", std::to_string(frames - 1)},
+                              {"source.faults.seed", "5"},
+                              {"source.faults.missed_trigger_rate", "0.08"},
+                              {"source.faults.bad_frame_rate", "0.08"},
+                              {"source.faults.dark_frame_rate", "0.08"}});
+  EXPECT_TRUE(run.finished);
+  EXPECT_FALSE(run.source_failed);
+  const std::uint64_t missed = summaryCount(run.summary, "missed triggers ([0-9]+)");
+  const std::uint64_t bad = summaryCount(run.summary, "bad frames ([0-9]+)");
+  const std::uint64_t dark = summaryCount(run.summary, "dark frames ([0-9]+)");
+  EXPECT_GT(missed + bad + dark, 3u);  // 60 frames at 8 % each: about 14 expected
+  EXPECT_EQ(summaryCount(run.summary, "missed ([0-9]+)"), missed);
+  EXPECT_EQ(summaryCount(run.summary, "grab errors ([0-9]+)"), bad);
+  // A black frame loses tracking once; the next good frame restarts it (measured: 2 dark frames,
+  // 2 losses, 2 recoveries, 4 lost frames: the dark one and the restart).
+  EXPECT_EQ(summaryCount(run.summary, "tracking: losses ([0-9]+)"), dark);
+  EXPECT_EQ(summaryCount(run.summary, "recoveries ([0-9]+)"), dark);
+  EXPECT_EQ(run.poses.size(), static_cast<std::size_t>(frames) - missed - bad);
+  for (const rover::PoseRecord& p : run.poses) {
+    ASSERT_TRUE(std::isfinite(p.p_w[0]) && std::isfinite(p.p_w[1]) && std::isfinite(p.p_w[2]));
+  }
+}
+
 }  // namespace
 }  // namespace sunvo

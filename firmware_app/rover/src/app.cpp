@@ -13,6 +13,7 @@
 #include "stages.hpp"
 #include "sunvo/core/geometry.hpp"
 #include "sunvo/rover/device_sources.hpp"
+#include "sunvo/rover/fault_injection.hpp"
 #include "sunvo/runtime/clock.hpp"
 
 namespace sunvo::rover {
@@ -84,6 +85,7 @@ struct RoverApp::Impl {
   AttitudeMailbox attitude;
   std::unique_ptr<TriggerSource> trigger;
   std::unique_ptr<FrameSource> source;
+  InjectedFaults injected;  // source.faults: what the fault decorators injected
   std::shared_ptr<const ReplaySchedule> schedule;
   std::unique_ptr<runtime::FramePool> pool;
   std::unique_ptr<runtime::FramePool> sun_pool;  // only when the provider needs images
@@ -163,6 +165,12 @@ Expected<std::unique_ptr<RoverApp>> RoverApp::create(const RoverConfig& config,
   }
   auto world = setUpWorld(config, dynamic_cast<const KittiReplaySource*>(impl->source.get()));
   if (!world) return world.status();
+  if (config.source.faults.enabled()) {
+    impl->trigger = std::make_unique<FaultyTrigger>(std::move(impl->trigger), config.source.faults,
+                                                    impl->injected);
+    impl->source = std::make_unique<FaultyFrameSource>(std::move(impl->source),
+                                                       config.source.faults, impl->injected);
+  }
 
   runtime::FramePoolOptions frame_options = config.frames;
   // Colour slots only where the source delivers colour (KITTI replay); the V4L2 cameras are grey
@@ -347,6 +355,12 @@ std::string RoverApp::summary() const {
           "), frames grabbed %" PRIu64 " (grab errors %" PRIu64 ", pool exhausted %" PRIu64 ")\n",
           g(h.triggers), g(h.trigger_timeouts), g(h.triggers_missed), g(h.triggers_duplicate),
           g(h.frames_grabbed), g(h.grab_errors), g(h.pool_exhausted));
+  if (s.config.source.faults.enabled()) {
+    appendf(&o,
+            "  faults injected (source.faults): missed triggers %" PRIu64 ", bad frames %" PRIu64
+            ", dark frames %" PRIu64 "\n",
+            g(s.injected.missed_triggers), g(s.injected.bad_frames), g(s.injected.dark_frames));
+  }
   appendf(&o, "  grab errors in a row: at most %" PRIu64 " (limit %d)%s\n",
           g(h.grab_errors_in_a_row_max), s.config.source.max_consecutive_bad_frames,
           h.source_fault_stop.load() ? ": capture stopped, the source fault persisted" : "");

@@ -258,6 +258,7 @@ pipeline::SunAidedOptions roverEstimatorDefaults() {
 Status RoverConfig::validate() const {
   SUNVO_RETURN_IF_ERROR(checkRange("source.max_consecutive_bad_frames",
                                    source.max_consecutive_bad_frames, 1, 1000000));
+  SUNVO_RETURN_IF_ERROR(source.faults.validate("source.faults"));
   const KittiSourceConfig& k = source.kitti;
   if (source.type == SourceType::kKitti) {
     if (k.drive_dir.empty()) return invalidArgument("source.kitti.drive_dir: empty");

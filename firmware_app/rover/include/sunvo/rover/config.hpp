@@ -111,6 +111,26 @@ struct V4l2SourceConfig {
   }
 };
 
+// Random faults injected at the capture seams for soak and HIL runs (fault_injection.hpp).
+struct FaultInjectionConfig {
+  int seed = 1;                      // draws; the same seed gives the same faults, >= 0
+  double missed_trigger_rate = 0.0;  // [0, 0.5]: share of trigger edges swallowed
+  double bad_frame_rate = 0.0;       // [0, 0.5]: share of frames whose grab fails
+  double dark_frame_rate = 0.0;      // [0, 0.5]: share of frames delivered all black
+  bool enabled() const {
+    return missed_trigger_rate > 0.0 || bad_frame_rate > 0.0 || dark_frame_rate > 0.0;
+  }
+  // Checks every range; the message names the key under `prefix` (e.g. "source.faults").
+  Status validate(const char* prefix) const;
+  template <class Self, class V>
+  static void fields(Self& s, V& v) {
+    v("seed", s.seed);
+    v("missed_trigger_rate", s.missed_trigger_rate);
+    v("bad_frame_rate", s.bad_frame_rate);
+    v("dark_frame_rate", s.dark_frame_rate);
+  }
+};
+
 struct SourceConfig {
   SourceType type = SourceType::kKitti;
   KittiSourceConfig kitti;
@@ -119,12 +139,15 @@ struct SourceConfig {
   // gives no frame while it is reopened) after which capture stops and sunvo_rover exits 1; each
   // failed grab before that drops its frame and counts in the summary's grab errors.
   int max_consecutive_bad_frames = 100;
+  // Random faults injected at the capture seams (soak / HIL runs; fault_injection.hpp). Off.
+  FaultInjectionConfig faults;
   template <class Self, class V>
   static void fields(Self& s, V& v) {
     v("type", s.type);
     v("kitti", s.kitti);
     v("v4l2", s.v4l2);
     v("max_consecutive_bad_frames", s.max_consecutive_bad_frames);
+    v("faults", s.faults);
   }
 };
 
