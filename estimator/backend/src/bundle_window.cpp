@@ -101,6 +101,7 @@ Status BundleWindow::init(const WindowOptions& options, const StereoCamera& came
 
   const int max_generic = static_cast<int>(residual_ids_.size()) - static_cast<int>(n_pool);
   SUNVO_RETURN_IF_ERROR(schur_.init(static_cast<int>(n_pool), options.max_landmarks, max_generic));
+  schur_.setStereoModel(&model_);
   if (options.solver != WindowSolver::kCeres) {
     initialized_ = true;
     reset(Isometry3::Identity());
@@ -356,7 +357,7 @@ Expected<WindowSolveSummary> BundleWindow::solve() {
           measurements_[r] =
               frames_[static_cast<std::size_t>(e->slot)].obs[static_cast<std::size_t>(e->obs)].y;
           if (!use_ceres) {
-            SUNVO_RETURN_IF_ERROR(schur_.addStereo(e->slot, cost_pool_[r].get(), loss_.get()));
+            SUNVO_RETURN_IF_ERROR(schur_.addStereo(e->slot, &measurements_[r], loss_.get()));
             continue;
           }
           PoseBlock& p = poses_[static_cast<std::size_t>(e->slot)];

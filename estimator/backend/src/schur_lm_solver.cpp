@@ -64,6 +64,49 @@ void applyCorrector(const Corrector& c, R& r, J& jac) {
   r *= c.r_scale;
 }
 
+// The stereo residual of stereo_residual.hpp (Eq. 1) in closed form, with its Jacobians in the
+// solver's local coordinates.
+//   p_k = C_k_b p_b + t_k_b = (x, y, z),  r = S (fu x/z + cu - u, fv y/z + cv - v, fu l/z - d),
+//   S = diag(1/su, 1/sv, 1/sd).
+// Local update of the rotation (EigenQuaternionManifold): q <- [cos|d|, sin|d| d/|d|] (x) q, a
+// rotation by the vector 2 d applied on the left, so C_k_b <- Exp(2 d) C_k_b and
+//   dp_k/dd = -2 [C_k_b p_b]x,  dp_k/dt = I,  dp_k/dp_b = C_k_b;
+//   dr/dp_k = S [[fu/z, 0, -fu x/z^2], [0, fv/z, -fv y/z^2], [0, 0, -fu l/z^2]].
+// At or behind the camera (z <= kMinDepth) r is the constant kBehindCameraResidual with zero
+// derivatives, as in the Ceres functor. J_pose may be null (only r and J_p are then written).
+void stereoResidual(const StereoModel& m, const StereoMeasurement& y, const double* q_k_b,
+                    const double* t_k_b, const double* p_b, Eigen::Vector3d* r,
+                    Eigen::Matrix<double, 3, 6>* J_pose, Eigen::Matrix3d* J_p) {
+  const Eigen::Map<const Eigen::Quaterniond> C_k_b(q_k_b);
+  const Eigen::Vector3d Cp = C_k_b * Eigen::Map<const Eigen::Vector3d>(p_b);
+  const Eigen::Vector3d p_k = Cp + Eigen::Map<const Eigen::Vector3d>(t_k_b);
+  if (!(p_k.z() > StereoResidual::kMinDepth)) {
+    r->setConstant(StereoResidual::kBehindCameraResidual);
+    if (J_pose != nullptr) J_pose->setZero();
+    if (J_p != nullptr) J_p->setZero();
+    return;
+  }
+  const double inv_z = 1.0 / p_k.z();
+  const double fl = m.fu * m.baseline_m;
+  (*r)(0) = m.sqrt_info_u * (m.fu * p_k.x() * inv_z + m.cu - y.u);
+  (*r)(1) = m.sqrt_info_v * (m.fv * p_k.y() * inv_z + m.cv - y.v);
+  (*r)(2) = m.sqrt_info_d * (fl * inv_z - y.d);
+  if (J_p == nullptr) return;
+  Eigen::Matrix3d P = Eigen::Matrix3d::Zero();
+  P(0, 0) = m.sqrt_info_u * m.fu * inv_z;
+  P(0, 2) = -m.sqrt_info_u * m.fu * p_k.x() * inv_z * inv_z;
+  P(1, 1) = m.sqrt_info_v * m.fv * inv_z;
+  P(1, 2) = -m.sqrt_info_v * m.fv * p_k.y() * inv_z * inv_z;
+  P(2, 2) = -m.sqrt_info_d * fl * inv_z * inv_z;
+  J_p->noalias() = P * C_k_b.toRotationMatrix();
+  if (J_pose == nullptr) return;
+  Eigen::Matrix3d minus_2_skew;
+  minus_2_skew << 0.0, 2.0 * Cp.z(), -2.0 * Cp.y(), -2.0 * Cp.z(), 0.0, 2.0 * Cp.x(), 2.0 * Cp.y(),
+      -2.0 * Cp.x(), 0.0;
+  J_pose->leftCols<3>().noalias() = P * minus_2_skew;
+  J_pose->rightCols<3>() = P;
+}
+
 using RowMat34 = Eigen::Matrix<double, 3, 4, Eigen::RowMajor>;
 using RowMat33 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
 using RowMat43 = Eigen::Matrix<double, 4, 3, Eigen::RowMajor>;
@@ -117,13 +160,14 @@ Status SchurLmSolver::addLandmark(double* p_b) {
   return Status::ok();
 }
 
-Status SchurLmSolver::addStereo(int slot, const ceres::CostFunction* cost,
+Status SchurLmSolver::addStereo(int slot, const StereoMeasurement* y,
                                 const ceres::LossFunction* loss) {
   if (n_landmarks_ == 0) return failedPrecondition("SchurLmSolver: addStereo before addLandmark");
+  if (model_ == nullptr) return failedPrecondition("SchurLmSolver: addStereo without a model");
   if (n_stereo_ >= max_stereo_) return invalidArgument("SchurLmSolver: too many stereo residuals");
   if (slot < 0 || slot >= n_poses_)
     return invalidArgument("SchurLmSolver: stereo slot out of range");
-  stereo_[static_cast<std::size_t>(n_stereo_++)] = Stereo{cost, loss, slot, n_landmarks_ - 1};
+  stereo_[static_cast<std::size_t>(n_stereo_++)] = Stereo{y, loss, slot, n_landmarks_ - 1};
   landmarks_[static_cast<std::size_t>(n_landmarks_ - 1)].end = n_stereo_;
   return Status::ok();
 }
@@ -209,11 +253,11 @@ bool SchurLmSolver::evaluateCost(bool candidate, double* cost) const {
     const Stereo& st = stereo_[static_cast<std::size_t>(i)];
     const auto s = static_cast<std::size_t>(st.slot);
     const bool moved = candidate && st.slot > 0;
-    const double* params[3] = {moved ? q_cand_[s].data() : q_[s], moved ? t_cand_[s].data() : t_[s],
-                               candidate ? p_cand_[static_cast<std::size_t>(st.landmark)].data()
-                                         : landmarks_[static_cast<std::size_t>(st.landmark)].p};
+    const double* p_b = candidate ? p_cand_[static_cast<std::size_t>(st.landmark)].data()
+                                  : landmarks_[static_cast<std::size_t>(st.landmark)].p;
     Vec3 r;
-    if (!st.cost->Evaluate(params, r.data(), nullptr)) return false;
+    stereoResidual(*model_, *st.y, moved ? q_cand_[s].data() : q_[s],
+                   moved ? t_cand_[s].data() : t_[s], p_b, &r, nullptr, nullptr);
     sum += correct(st.loss, r.squaredNorm()).cost;
   }
   for (int i = 0; i < n_generic_; ++i) {
@@ -248,17 +292,15 @@ bool SchurLmSolver::linearize(double* cost) {
       const Stereo& st = stereo_[static_cast<std::size_t>(i)];
       StereoLin& lin = lin_[static_cast<std::size_t>(i)];
       const auto s = static_cast<std::size_t>(st.slot);
-      const double* params[3] = {q_[s], t_[s], lm.p};
-      RowMat34 J_q;
-      RowMat33 J_t;
-      RowMat33 J_p;
-      double* jac[3] = {st.slot > 0 ? J_q.data() : nullptr, st.slot > 0 ? J_t.data() : nullptr,
-                        J_p.data()};
-      if (!st.cost->Evaluate(params, lin.r.data(), jac)) return false;
-      Eigen::Matrix<double, 3, 9> J = Eigen::Matrix<double, 3, 9>::Zero();
+      Eigen::Matrix<double, 3, 9> J;
+      Eigen::Matrix<double, 3, 6> J_pose;
+      Mat3 J_p;
+      stereoResidual(*model_, *st.y, q_[s], t_[s], lm.p, &lin.r, st.slot > 0 ? &J_pose : nullptr,
+                     &J_p);
       if (st.slot > 0) {
-        J.leftCols<3>() = J_q * plus_jac[st.slot];
-        J.middleCols<3>(3) = J_t;
+        J.leftCols<6>() = J_pose;
+      } else {
+        J.leftCols<6>().setZero();
       }
       J.rightCols<3>() = J_p;
       const Corrector c = correct(st.loss, lin.r.squaredNorm());

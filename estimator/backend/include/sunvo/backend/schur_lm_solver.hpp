@@ -5,14 +5,16 @@
 // Why not ceres::Solve: Ceres builds its program, evaluator and linear solver on every call
 // (≈ 15 500 heap allocations per frame of the image pipeline, docs/benchmarks.md) and its
 // general sparse machinery costs more than the two-frame problem itself. This solver keeps every
-// buffer from init() and allocates nothing per solve; it still uses Ceres' modelling pieces
-// (ceres::CostFunction, ceres::LossFunction, EigenQuaternionManifold), so every residual of the
-// window, the sun's included, is the same code under either solver.
+// buffer from init() and allocates nothing per solve. It evaluates the stereo residuals (most of
+// the work) in closed form, with the same formula as the Ceres functor, and every other residual
+// (motion prior, the sun's) through its ceres::CostFunction; losses are ceres::LossFunction and
+// the rotation update is EigenQuaternionManifold's, so both solvers minimise the same cost.
 //
 // Unknowns. Pose slot s >= 1 (slot 0 is the gauge, constant): q_k_b (4, local update
-// q <- Exp(dtheta) q as EigenQuaternionManifold) and t_k_b (3); caller blocks ("extra", e.g. the
-// sun's base-attitude correction, Euclidean); landmarks p_b (3 each). The reduced ("camera")
-// vector x_c = [dtheta_1 dt_1 ... dtheta_{n-1} dt_{n-1} extra...] has at most kMaxReducedDim rows.
+// q <- [cos|d|, sin|d| d/|d|] (x) q as EigenQuaternionManifold, a rotation by 2 d) and t_k_b (3);
+// caller blocks ("extra", e.g. the sun's base-attitude correction, Euclidean); landmarks p_b (3
+// each). The reduced ("camera") vector x_c = [dtheta_1 dt_1 ... dtheta_{n-1} dt_{n-1} extra...] has
+// at most kMaxReducedDim rows.
 //
 // One iteration, at the current linearisation (J, r whitened and robustified):
 //   H = J^T J, g = J^T r, D = clamp(diag H, 1e-6, 1e32), lambda = 1 / radius;
@@ -41,6 +43,7 @@
 #include <span>
 #include <vector>
 
+#include "sunvo/backend/stereo_residual.hpp"
 #include "sunvo/core/status.hpp"
 
 namespace sunvo::backend {
@@ -79,8 +82,13 @@ class SchurLmSolver {
   Status begin(int n_poses, std::span<double* const> q, std::span<double* const> t);
   // A landmark p_b (3 doubles, updated in place); its stereo residuals follow it (addStereo).
   Status addLandmark(double* p_b);
-  // A 3-row residual over (q_slot, t_slot, p_b) of the landmark added last.
-  Status addStereo(int slot, const ceres::CostFunction* cost, const ceres::LossFunction* loss);
+  // The stereo model (intrinsics, baseline, measurement weights) of every stereo residual; it
+  // must outlive the solves.
+  void setStereoModel(const StereoModel* model) { model_ = model; }
+  // The stereo residual of stereo_residual.hpp (Eq. 1, evaluated here in closed form) of
+  // measurement *y (valid until solve() returns) over (q_slot, t_slot, p_b) of the landmark added
+  // last.
+  Status addStereo(int slot, const StereoMeasurement* y, const ceres::LossFunction* loss);
   // Any other residual: blocks in the cost function's order (rows <= kMaxGenericRows).
   Status addGeneric(const ceres::CostFunction* cost, const ceres::LossFunction* loss,
                     std::span<const BlockRef> blocks);
@@ -105,7 +113,7 @@ class SchurLmSolver {
   using VecR = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxReducedDim, 1>;
 
   struct Stereo {
-    const ceres::CostFunction* cost;
+    const StereoMeasurement* y;
     const ceres::LossFunction* loss;
     int slot;
     int landmark;
@@ -173,6 +181,7 @@ class SchurLmSolver {
   MatR S_;
   Eigen::LDLT<MatR> ldlt_;
   ceres::EigenQuaternionManifold manifold_;
+  const StereoModel* model_ = nullptr;
 };
 
 }  // namespace sunvo::backend
