@@ -13,8 +13,12 @@
 // A third run times the back end alone (vo::StereoTrackOdometry, track mode) on the real feature
 // tracks of KITTI 2011_09_30_drive_0020 (1000 frames, SURF+KLT tracks, ~65 observations per frame).
 //
+// With --peer NAME, a peer VO library built outside the tree (libviso2; sunvo/bench/peer.hpp)
+// then runs in the same process over the same frames, warm-up and timed count, on the same pinned
+// CPU, and its per-frame wall and thread CPU times are printed with the ratios sunvo/peer.
+//
 // Usage: sunvo_bench_vo [--frames=N] [--warmup=N] [--data=DIR] [--tracks=DIR|--tracks=]
-//                       [--cpu=K] [--benchmark_*]
+//                       [--cpu=K] [--peer=libviso2] [--benchmark_*]
 //   --cpu=K pins the process to CPU K (sched_setaffinity) before anything runs;
 //   --tracks= (empty) skips the track-mode run; --benchmark_* options go to Google Benchmark.
 //   Options: sunvo_bench_vo --help.
@@ -32,6 +36,7 @@
 
 #include "sunvo/bench/bench_support.hpp"
 #include "sunvo/bench/benchmark_cli.hpp"
+#include "sunvo/bench/peer.hpp"
 #include "sunvo/cli/cli.hpp"
 #include "sunvo/dataset/track_folder.hpp"
 #include "sunvo/files/tracks_io.hpp"
@@ -47,6 +52,7 @@ constexpr double kTargetP99Ms = 35.0;
 
 struct Config : sunvo::bench::BenchConfig {
   std::string tracks = std::string(SUNVO_DATA_DIR) + "/kitti_tracks/2011_09_30_drive_0020";
+  std::string peer;  // empty: no peer run
 };
 
 struct Run {
@@ -350,6 +356,32 @@ void printSummary() {
       c50, kTargetMedianMs, c50 / kTargetMedianMs, c99, kTargetP99Ms, c99 / kTargetP99Ms);
 }
 
+// The peer's times next to the full pipeline's (same frames, same process, same CPU).
+void printPeer(const sunvo::bench::PeerRun& p) {
+  std::printf(
+      "\n[peer %s] %zu frames of %dx%d (00_first_frames ping-pong) after %d warm-up frames, "
+      "same process and CPU, run after sunvo's runs\n",
+      p.name.c_str(), p.wall_ms.size(), g_data.camera.width, g_data.camera.height, g_config.warmup);
+  std::printf("%-36s %9s %9s %9s %9s %9s\n", "per frame [ms]", "median", "p95", "p99", "max",
+              "mean");
+  row("peer wall time", p.wall_ms);
+  row("peer thread CPU time", p.cpu_ms);
+  row("sunvo pipeline wall (outer)", g_full.outer_ms);
+  row("sunvo pipeline thread CPU", g_full.cpu_ms);
+  std::printf(
+      "peer: %d failed frames; matches median %.0f, inliers median %.0f (min %.0f), "
+      "|t| per frame median %.3f m\n",
+      p.failures, percentile(p.matches, 0.5), percentile(p.inliers, 0.5),
+      percentile(p.inliers, 0.0), percentile(p.translation_m, 0.5));
+  auto ratio = [](const std::vector<double>& a, const std::vector<double>& b, double q) {
+    return percentile(a, q) / percentile(b, q);
+  };
+  std::printf("ratio sunvo/%s: wall median %.2f, p99 %.2f; thread CPU median %.2f, p99 %.2f\n",
+              p.name.c_str(), ratio(g_full.outer_ms, p.wall_ms, 0.5),
+              ratio(g_full.outer_ms, p.wall_ms, 0.99), ratio(g_full.cpu_ms, p.cpu_ms, 0.5),
+              ratio(g_full.cpu_ms, p.cpu_ms, 0.99));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -363,6 +395,17 @@ int main(int argc, char** argv) {
   app.add_option("--tracks", g_config.tracks,
                  "feature-track folder of the back-end-only run (--tracks= skips it)")
       ->expected(0, 1);
+  app.add_option("--peer", g_config.peer,
+                 "after sunvo's runs, time this peer VO library on the same frames (libviso2; "
+                 "needs a build configured with -DSUNVO_LIBVISO2_DIR)")
+      ->check(CLI::Validator(
+          [](std::string& name) {
+            for (const std::string& p : sunvo::bench::availablePeers()) {
+              if (p == name) return std::string();
+            }
+            return sunvo::bench::peerUnavailableMessage(name);
+          },
+          "PEER", "built-in peer"));
   if (auto code = sunvo::bench::parseWithBenchmarkFlags(app, argc, argv)) return *code;
   auto data = sunvo::bench::prepareBenchmark(g_config, sunvo::runtime::allocCounterActive());
   if (!data) return sunvo::cli::fail(kProgram, data.status());
@@ -390,5 +433,10 @@ int main(int argc, char** argv) {
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
   printSummary();
+  if (!g_config.peer.empty()) {
+    auto peer = sunvo::bench::runPeer(g_config.peer, g_data, g_config);
+    if (!peer) return sunvo::cli::fail(kProgram, peer.status());
+    if (g_full.ok) printPeer(*peer);
+  }
   return g_full.ok ? sunvo::cli::kExitOk : sunvo::cli::kExitFailure;
 }
