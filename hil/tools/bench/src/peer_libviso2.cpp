@@ -6,73 +6,59 @@
 // sunvo reads (no copy: dims = width, height, bytes per line); libviso2 copies them into its own
 // aligned buffers inside process(), which is part of its timed work.
 
-#include <chrono>
 #include <cmath>
-#include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "sunvo/bench/peer.hpp"
 #include "viso_stereo.h"
 
 namespace sunvo::bench {
+namespace {
 
-Expected<PeerRun> runLibviso2(const KittiFrames& data, const BenchConfig& config) {
-  const std::size_t n = data.frames.size();
-  if (n < 2) return Status(StatusCode::kInvalidArgument, "libviso2 peer: needs >= 2 frames");
-  // libviso2 reads 8-bit single-channel images; sunvo's KITTI frames already are, but convert
-  // (outside the timed calls) should a colour sequence be given.
-  std::vector<cv::Mat> left(n), right(n);
-  for (std::size_t k = 0; k < n; ++k) {
-    const cv::Mat& l = data.frames[k].left;
-    const cv::Mat& r = data.frames[k].right;
-    if (l.size() != r.size() || l.empty()) {
-      return Status(StatusCode::kInvalidArgument,
-                    "libviso2 peer: frame " + std::to_string(k) + " has unequal or empty images");
-    }
-    if (l.type() == CV_8UC1) {
-      left[k] = l;
-      right[k] = r;
-    } else {
-      cv::cvtColor(l, left[k], cv::COLOR_BGR2GRAY);
-      cv::cvtColor(r, right[k], cv::COLOR_BGR2GRAY);
-    }
-  }
-
+VisualOdometryStereo::parameters kittiDemoParameters(const StereoCamera& camera) {
   VisualOdometryStereo::parameters param;
-  param.calib.f = data.camera.fu;
-  param.calib.cu = data.camera.cu;
-  param.calib.cv = data.camera.cv;
-  param.base = data.camera.baseline_m;
-  VisualOdometryStereo viso(param);
+  param.calib.f = camera.fu;
+  param.calib.cu = camera.cu;
+  param.calib.cv = camera.cv;
+  param.base = camera.baseline_m;
+  return param;
+}
 
-  PeerRun run;
-  run.name = "libviso2";
-  auto feed = [&](std::size_t index) {
-    const std::size_t k = pingPong(index, n);
-    int32_t dims[3] = {left[k].cols, left[k].rows, static_cast<int32_t>(left[k].step[0])};
-    return viso.process(left[k].data, right[k].data, dims);
-  };
-  std::size_t i = 0;
-  for (int w = 0; w < config.warmup; ++w, ++i) (void)feed(i);
-  for (int f = 0; f < config.frames; ++f, ++i) {
-    const double cpu0 = threadCpuMs();
-    const auto t0 = std::chrono::steady_clock::now();
-    const bool ok = feed(i);
-    const auto t1 = std::chrono::steady_clock::now();
-    const double cpu1 = threadCpuMs();
-    run.wall_ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
-    run.cpu_ms.push_back(cpu1 - cpu0);
-    run.matches.push_back(viso.getNumberOfMatches());
-    run.inliers.push_back(viso.getNumberOfInliers());
-    if (!ok) {
-      ++run.failures;
-      continue;
+class Libviso2Odometry final : public PeerOdometry {
+ public:
+  explicit Libviso2Odometry(const StereoCamera& camera) : viso_(kittiDemoParameters(camera)) {}
+
+  bool process(const cv::Mat& left, const cv::Mat& right) override {
+    const cv::Mat* l = &left;
+    const cv::Mat* r = &right;
+    if (left.type() != CV_8UC1) {  // libviso2 reads 8-bit single-channel rows
+      cv::cvtColor(left, grey_left_, cv::COLOR_BGR2GRAY);
+      cv::cvtColor(right, grey_right_, cv::COLOR_BGR2GRAY);
+      l = &grey_left_;
+      r = &grey_right_;
     }
-    const Matrix T = viso.getMotion();
-    run.translation_m.push_back(std::sqrt(T.val[0][3] * T.val[0][3] + T.val[1][3] * T.val[1][3] +
-                                          T.val[2][3] * T.val[2][3]));
+    if (l->size() != r->size() || l->step[0] != r->step[0] || l->empty()) return false;
+    int32_t dims[3] = {l->cols, l->rows, static_cast<int32_t>(l->step[0])};
+    return viso_.process(l->data, r->data, dims);
   }
-  return run;
+  // libviso2's getters are not const.
+  int matches() const override { return viso_.getNumberOfMatches(); }
+  int inliers() const override { return viso_.getNumberOfInliers(); }
+  double translationM() const override {
+    const Matrix T = viso_.getMotion();
+    return std::sqrt(T.val[0][3] * T.val[0][3] + T.val[1][3] * T.val[1][3] +
+                     T.val[2][3] * T.val[2][3]);
+  }
+
+ private:
+  mutable VisualOdometryStereo viso_;
+  cv::Mat grey_left_, grey_right_;
+};
+
+}  // namespace
+
+std::unique_ptr<PeerOdometry> makeLibviso2(const StereoCamera& camera) {
+  return std::make_unique<Libviso2Odometry>(camera);
 }
 
 }  // namespace sunvo::bench
