@@ -187,6 +187,9 @@ int main(int argc, char** argv) {
   const long rss_end_kb = residentKb();
   auto profile = (*app)->writeProfile("final");
   std::printf("sunvo_rover: stopped (%s)\n%s", reason, (*app)->summary().c_str());
+  std::printf("  clock: %llu wall-clock jumps (last %+.3f s); frame times kept the start offset\n",
+              static_cast<unsigned long long>(supervisor.watch().clockJumps()),
+              static_cast<double>(supervisor.watch().lastClockJumpNs()) * 1e-9);
   if (rss_warm_kb >= 0) {
     std::printf(
         "  rss: %ld kB at start, %ld kB after warm-up (frame %llu), %ld kB at the end: "

@@ -1,11 +1,13 @@
 // HealthWatch on hand-made counter samples (a stalled camera, an estimator lost on every frame or
-// stalled, a replay that ended), and the start-up clock check on given adjtimex results.
+// stalled, a replay that ended, a wall clock stepped both ways), and the start-up clock check on
+// given adjtimex results.
 
 #include "sunvo/rover/health_watch.hpp"
 
 #include <gtest/gtest.h>
 #include <sys/timex.h>
 
+#include <cstdlib>
 #include <string>
 
 namespace sunvo::rover {
@@ -35,6 +37,42 @@ TEST(HealthWatch, HealthyWhileEveryCounterAdvances) {
   }
   EXPECT_TRUE(w.healthy());
   EXPECT_FALSE(w.mustExit());
+}
+
+TEST(HealthWatch, AWallClockStepIsCountedOnceEachWayASlewAndUnreadClockAreNot) {
+  HealthWatch w(testConfig(), 0, "/dev/a + /dev/b");
+  constexpr TimeNs kHour = 3'600'000'000'000;
+  const TimeNs utc0 = 1'700'000'000'000'000'000;  // UTC - monotonic at the start
+  TimeNs step = 0;
+  TimeNs slew = 0;
+  for (int k = 1; k <= 120; ++k) {
+    const TimeNs now = k * 50 * kMs;
+    if (k == 40) step += kHour;  // forward one hour
+    if (k == 80) step -= kHour;  // and back
+    slew += 20'000;              // 0.4 ms/s: an NTP slew, never a jump
+    HealthSample s = running(now, static_cast<std::uint64_t>(k));
+    s.utc_ns = k % 10 == 5 ? 0 : utc0 + now + slew + step;  // 0: a sample without a UTC read
+    EXPECT_EQ(w.update(s), HealthFault::kNone) << k;
+    if (k == 40) {
+      EXPECT_LT(std::llabs(w.lastClockJumpNs() - kHour), kMs);  // the step + one slew
+    }
+  }
+  EXPECT_EQ(w.clockJumps(), 2u);
+  EXPECT_LT(std::llabs(w.lastClockJumpNs() + kHour), kMs);
+  EXPECT_TRUE(w.healthy());
+  // Just above the threshold counts, just below does not.
+  HealthWatch v(testConfig(), 0, "cam");
+  HealthSample a = running(50 * kMs, 1);
+  a.utc_ns = utc0;
+  v.update(a);
+  HealthSample b = running(100 * kMs, 2);
+  b.utc_ns = utc0 + 50 * kMs + HealthWatch::kClockJumpNs - kMs;
+  v.update(b);
+  EXPECT_EQ(v.clockJumps(), 0u);
+  HealthSample c = running(150 * kMs, 3);
+  c.utc_ns = b.utc_ns + 50 * kMs - HealthWatch::kClockJumpNs - 2 * kMs;
+  v.update(c);
+  EXPECT_EQ(v.clockJumps(), 1u);
 }
 
 TEST(HealthWatch, SilentCameraIsAFaultNamingTheDeviceThenAnExit) {

@@ -325,6 +325,7 @@ HealthSample RoverApp::healthSample(TimeNs now) const {
   auto g = [](const std::atomic<std::uint64_t>& a) { return a.load(std::memory_order_relaxed); };
   HealthSample out;
   out.now_ns = now;
+  out.utc_ns = runtime::utcNowNs();
   out.frames_grabbed = g(h.frames_grabbed);
   out.grab_errors = g(h.grab_errors);
   out.trigger_timeouts = g(h.trigger_timeouts);

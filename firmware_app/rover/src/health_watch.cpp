@@ -33,6 +33,16 @@ HealthWatch::HealthWatch(const HealthConfig& config, TimeNs start_ns, std::strin
 
 HealthFault HealthWatch::update(const HealthSample& s) {
   const TimeNs now = s.now_ns;
+  if (s.utc_ns != 0) {
+    const TimeNs offset = s.utc_ns - now;
+    if (have_utc_offset_ &&
+        std::max(offset - utc_offset_ns_, utc_offset_ns_ - offset) > kClockJumpNs) {
+      ++clock_jumps_;
+      last_clock_jump_ns_ = offset - utc_offset_ns_;
+    }
+    utc_offset_ns_ = offset;  // a slew is followed sample by sample, never counted
+    have_utc_offset_ = true;
+  }
   // The counters are read one by one (relaxed): lost may briefly exceed processed.
   const std::uint64_t tracked =
       s.frames_processed > s.lost_frames ? s.frames_processed - s.lost_frames : 0;

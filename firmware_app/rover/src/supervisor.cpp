@@ -19,7 +19,15 @@ void Supervisor::ready() {
 }
 
 std::optional<int> Supervisor::tick(TimeNs now) {
+  const std::uint64_t jumps_before = watch_.clockJumps();
   const HealthFault fault = watch_.update(app_.healthSample(now));
+  if (watch_.clockJumps() != jumps_before) {
+    log_.log(runtime::LogPriority::kWarning,
+             "clock: the wall clock jumped %+.3f s (UTC - monotonic; jump %llu); frame times keep "
+             "the offset taken at start",
+             static_cast<double>(watch_.lastClockJumpNs()) * 1e-9,
+             static_cast<unsigned long long>(watch_.clockJumps()));
+  }
   if (fault != logged_) {
     if (fault == HealthFault::kNone) {
       log_.log(runtime::LogPriority::kInfo, "recovered from fault (%s)", healthFaultName(logged_));

@@ -15,8 +15,14 @@
 // A third run times the back end alone (vo::StereoTrackOdometry, track mode) on the real feature
 // tracks of KITTI 2011_09_30_drive_0020 (1000 frames, SURF+KLT tracks, ~65 observations per frame).
 //
+// With --peer NAME, a peer VO library built outside the tree (libviso2; sunvo/bench/peer.hpp)
+// then runs in the same process over the same frames, warm-up and timed count, on the same pinned
+// CPU, twice: alone after sunvo's runs, and interleaved frame by frame with a fresh sunvo
+// pipeline (sunvo frame k, peer frame k, ...: both see the same load on the shared core). Its
+// per-frame wall and thread CPU times are printed with the ratios sunvo/peer of each.
+//
 // Usage: sunvo_bench_vo [--frames=N] [--warmup=N] [--data=DIR] [--tracks=DIR|--tracks=]
-//                       [--cpu=K] [--benchmark_*]
+//                       [--cpu=K] [--peer=libviso2] [--benchmark_*]
 //   --cpu=K pins the process to CPU K (sched_setaffinity) before anything runs;
 //   --tracks= (empty) skips the track-mode run; --benchmark_* options go to Google Benchmark.
 //   Options: sunvo_bench_vo --help.
@@ -34,6 +40,7 @@
 
 #include "sunvo/bench/bench_support.hpp"
 #include "sunvo/bench/benchmark_cli.hpp"
+#include "sunvo/bench/peer.hpp"
 #include "sunvo/cli/cli.hpp"
 #include "sunvo/dataset/track_folder.hpp"
 #include "sunvo/files/tracks_io.hpp"
@@ -49,6 +56,7 @@ constexpr double kTargetP99Ms = 35.0;
 
 struct Config : sunvo::bench::BenchConfig {
   std::string tracks = std::string(SUNVO_DATA_DIR) + "/kitti_tracks/2011_09_30_drive_0020";
+  std::string peer;  // empty: no peer run
 };
 
 struct Run {
@@ -375,6 +383,77 @@ void printSummary() {
       c50, kTargetMedianMs, c50 / kTargetMedianMs, c99, kTargetP99Ms, c99 / kTargetP99Ms);
 }
 
+// sunvo's full pipeline and a peer, frame by frame alternately (same frames, same load).
+struct Interleaved {
+  std::vector<double> sunvo_wall_ms, sunvo_cpu_ms;
+  sunvo::bench::PeerRun peer;
+};
+
+sunvo::Expected<Interleaved> runInterleaved(const std::string& name) {
+  auto peer = sunvo::bench::makePeer(name, g_data.camera);
+  if (!peer) return peer.status();
+  sunvo::pipeline::StereoImageOdometry vo;
+  SUNVO_RETURN_IF_ERROR(vo.init(sunvo::pipeline::PipelineOptions{}, g_data.camera));
+  const std::size_t n = g_data.frames.size();
+  sunvo::StereoFrame frame;
+  auto feed = [&](std::size_t index) {
+    const sunvo::StereoFrame& src = g_data.frames[sunvo::bench::pingPong(index, n)];
+    frame.left = src.left;
+    frame.right = src.right;
+    frame.sequence = index;
+    frame.trigger_time_ns = 1'000'000'000 + static_cast<sunvo::TimeNs>(index) * 100'000'000;
+    return vo.process(frame).hasValue();
+  };
+  Interleaved r;
+  r.peer.name = name;
+  std::size_t i = 0;
+  for (int w = 0; w < g_config.warmup; ++w, ++i) {
+    if (!feed(i)) return sunvo::Status(sunvo::StatusCode::kInternal, "process failed in warm-up");
+    const sunvo::StereoFrame& src = g_data.frames[sunvo::bench::pingPong(i, n)];
+    (void)(*peer)->process(src.left, src.right);
+  }
+  for (int k = 0; k < g_config.frames; ++k, ++i) {
+    const double cpu0 = sunvo::bench::threadCpuMs();
+    const auto t0 = std::chrono::steady_clock::now();
+    const bool ok = feed(i);
+    const auto t1 = std::chrono::steady_clock::now();
+    const double cpu1 = sunvo::bench::threadCpuMs();
+    if (!ok) return sunvo::Status(sunvo::StatusCode::kInternal, "process failed");
+    r.sunvo_wall_ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+    r.sunvo_cpu_ms.push_back(cpu1 - cpu0);
+    sunvo::bench::timePeerFrame(**peer, g_data, i, r.peer);
+  }
+  return r;
+}
+
+// The peer's times next to sunvo's (same frames, same process, same CPU).
+void printPeer(const char* how, const sunvo::bench::PeerRun& p,
+               const std::vector<double>& sunvo_wall_ms, const std::vector<double>& sunvo_cpu_ms) {
+  std::printf(
+      "\n[peer %s, %s] %zu frames of %dx%d (00_first_frames ping-pong) after %d warm-up frames, "
+      "same process and CPU\n",
+      p.name.c_str(), how, p.wall_ms.size(), g_data.camera.width, g_data.camera.height,
+      g_config.warmup);
+  std::printf("%-36s %9s %9s %9s %9s %9s\n", "per frame [ms]", "median", "p95", "p99", "max",
+              "mean");
+  row("peer wall time", p.wall_ms);
+  row("peer thread CPU time", p.cpu_ms);
+  row("sunvo pipeline wall (outer)", sunvo_wall_ms);
+  row("sunvo pipeline thread CPU", sunvo_cpu_ms);
+  std::printf(
+      "peer: %d failed frames; matches median %.0f, inliers median %.0f (min %.0f), "
+      "|t| per frame median %.3f m\n",
+      p.failures, percentile(p.matches, 0.5), percentile(p.inliers, 0.5),
+      percentile(p.inliers, 0.0), percentile(p.translation_m, 0.5));
+  auto ratio = [](const std::vector<double>& a, const std::vector<double>& b, double q) {
+    return percentile(a, q) / percentile(b, q);
+  };
+  std::printf("ratio sunvo/%s (%s): wall median %.2f, p99 %.2f; thread CPU median %.2f, p99 %.2f\n",
+              p.name.c_str(), how, ratio(sunvo_wall_ms, p.wall_ms, 0.5),
+              ratio(sunvo_wall_ms, p.wall_ms, 0.99), ratio(sunvo_cpu_ms, p.cpu_ms, 0.5),
+              ratio(sunvo_cpu_ms, p.cpu_ms, 0.99));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -388,6 +467,17 @@ int main(int argc, char** argv) {
   app.add_option("--tracks", g_config.tracks,
                  "feature-track folder of the back-end-only run (--tracks= skips it)")
       ->expected(0, 1);
+  app.add_option("--peer", g_config.peer,
+                 "after sunvo's runs, time this peer VO library on the same frames (libviso2; "
+                 "needs a build configured with -DSUNVO_LIBVISO2_DIR)")
+      ->check(CLI::Validator(
+          [](std::string& name) {
+            for (const std::string& p : sunvo::bench::availablePeers()) {
+              if (p == name) return std::string();
+            }
+            return sunvo::bench::peerUnavailableMessage(name);
+          },
+          "PEER", "built-in peer"));
   if (auto code = sunvo::bench::parseWithBenchmarkFlags(app, argc, argv)) return *code;
   auto data = sunvo::bench::prepareBenchmark(g_config, sunvo::runtime::allocCounterActive());
   if (!data) return sunvo::cli::fail(kProgram, data.status());
@@ -420,5 +510,16 @@ int main(int argc, char** argv) {
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
   printSummary();
+  if (!g_config.peer.empty()) {
+    auto peer = sunvo::bench::runPeer(g_config.peer, g_data, g_config);
+    if (!peer) return sunvo::cli::fail(kProgram, peer.status());
+    auto both = runInterleaved(g_config.peer);
+    if (!both) return sunvo::cli::fail(kProgram, both.status());
+    if (g_full.ok) {
+      printPeer("alone, after sunvo's runs", *peer, g_full.outer_ms, g_full.cpu_ms);
+      printPeer("interleaved frame by frame with sunvo", both->peer, both->sunvo_wall_ms,
+                both->sunvo_cpu_ms);
+    }
+  }
   return g_full.ok ? sunvo::cli::kExitOk : sunvo::cli::kExitFailure;
 }

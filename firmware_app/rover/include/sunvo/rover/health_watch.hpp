@@ -9,6 +9,12 @@
 //   lost:   frames are processed but none tracked (frames_processed - lost_frames stands still);
 //   pose:   poses_published has not advanced (while the estimator runs).
 // The camera comes first (it explains the other two). Healthy = no fault = feed the watchdog.
+//
+// Clock jumps: each sample also carries the wall clock (UTC) read with it. When UTC - monotonic
+// changes by more than kClockJumpNs between two samples, the wall clock was stepped (settimeofday,
+// an NTP step; a slew changes it by at most 0.5 ms/s): the jump is counted, not a fault. Frame
+// times do not follow it: they are monotonic stamps mapped to UTC with the offset taken when the
+// source opened (RoverApp), so dt and the sun's ephemeris time stay continuous.
 
 #include <cstdint>
 #include <string>
@@ -21,6 +27,7 @@ namespace sunvo::rover {
 // The counters the watch reads (RoverApp::healthSample()).
 struct HealthSample {
   TimeNs now_ns = 0;  // monotonic
+  TimeNs utc_ns = 0;  // wall clock (UTC) read just after now_ns; 0: not read (no jump check)
   std::uint64_t frames_grabbed = 0;
   std::uint64_t grab_errors = 0;
   std::uint64_t trigger_timeouts = 0;
@@ -50,6 +57,12 @@ class HealthWatch {
   // The present fault in words, naming the device and the counters (fixed buffer).
   const char* reason() const { return reason_; }
 
+  // A change of UTC - monotonic above this between two samples is a wall-clock jump.
+  static constexpr TimeNs kClockJumpNs = 1'000'000'000;
+  // Wall-clock jumps seen so far, and the size of the last one (UTC - monotonic, after - before).
+  std::uint64_t clockJumps() const { return clock_jumps_; }
+  TimeNs lastClockJumpNs() const { return last_clock_jump_ns_; }
+
  private:
   HealthConfig config_;
   std::string camera_;
@@ -58,6 +71,10 @@ class HealthWatch {
   HealthFault fault_ = HealthFault::kNone;
   TimeNs fault_age_ns_ = 0;
   char reason_[256] = "";
+  bool have_utc_offset_ = false;
+  TimeNs utc_offset_ns_ = 0;  // UTC - monotonic at the last sample
+  std::uint64_t clock_jumps_ = 0;
+  TimeNs last_clock_jump_ns_ = 0;
 };
 
 // The kernel's view of the system clock (adjtimex(2) with modes = 0).

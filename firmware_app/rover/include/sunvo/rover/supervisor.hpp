@@ -1,7 +1,8 @@
 #pragma once
 // The supervising side of sunvo_rover (its main thread, every ~50 ms, never per frame): feeds the
 // HealthWatch from the running RoverApp, tells systemd READY=1 / WATCHDOG=1 / STATUS= /
-// STOPPING=1 (SdNotifier), logs the events (start, ready, fault, recovery, fault exit) as
+// STOPPING=1 (SdNotifier), logs the events (start, ready, fault, recovery, fault exit, a
+// wall-clock jump: HealthWatch::clockJumps) as
 // journal lines with priorities (EventLog), and says when a fault has lasted past
 // health.fault_exit_s. WATCHDOG=1 goes out every half $WATCHDOG_USEC, only while healthy: a
 // stalled stage stops the pings and systemd restarts the service.
