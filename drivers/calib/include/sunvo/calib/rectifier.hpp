@@ -3,11 +3,11 @@
 //
 // Computed once from a RawStereoCalibration: cv::stereoRectify (CALIB_ZERO_DISPARITY, free
 // scaling `alpha`) or, for the equidistant model, cv::fisheye::stereoRectify (balance = alpha),
-// then cv::initUndistortRectifyMap into fixed-point maps (CV_16SC2 + CV_16UC1). Per frame,
-// cv::remap (bilinear, black outside the raw image) writes into the caller's Mats, which are
-// allocated by the first frame and reused after; the remap runs in row bands of at most 2^16
-// pixels, which OpenCV's parallel_for_ runs inline on the calling thread, so a frame allocates
-// nothing and starts no worker threads (tests/calib/rectifier_test.cpp counts it).
+// then cv::initUndistortRectifyMap into fixed-point maps (CV_16SC2 + CV_16UC1). Per frame, a
+// bilinear remap with those maps (the arithmetic of cv::remap's INTER_LINEAR, black outside the
+// raw image; cv::remap itself allocates block buffers on every call) writes into the caller's
+// Mats, which are allocated by the first frame and reused after: a frame allocates nothing
+// (tests/calib/rectifier_test.cpp counts it) and runs on the calling thread.
 //
 // Frames: l = raw left camera, r = raw right, c = the rectified left camera (the estimator's
 // camera frame). stereoRectify's R1 is C_c_l (p_c = C_c_l p_l); both rectified cameras share the
@@ -53,7 +53,7 @@ class StereoRectifier {
   // or type differs. Times and sequence are copied. Fails (naming the eye) on a wrong size or
   // type; never allocates on success once warm.
   Status rectify(const StereoFrame& raw, StereoFrame& out) const;
-  // One image of one eye (right = false: left). Any type cv::remap takes.
+  // One image of one eye (right = false: left), CV_8UC1 or CV_8UC3.
   Status rectifyEye(const cv::Mat& raw, bool right, cv::Mat& out) const;
 
   // The maps (for tests and tools): map1 CV_16SC2, map2 CV_16UC1 of the rectified size.
