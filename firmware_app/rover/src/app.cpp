@@ -13,6 +13,7 @@
 #include "stages.hpp"
 #include "sunvo/core/geometry.hpp"
 #include "sunvo/rover/device_sources.hpp"
+#include "sunvo/rover/mavlink_link.hpp"
 #include "sunvo/runtime/clock.hpp"
 
 namespace sunvo::rover {
@@ -165,9 +166,10 @@ Expected<std::unique_ptr<RoverApp>> RoverApp::create(const RoverConfig& config,
   if (!world) return world.status();
 
   runtime::FramePoolOptions frame_options = config.frames;
-  // Colour slots only where the source delivers colour (KITTI replay); the V4L2 cameras are grey
-  // and the image providers then get the grey left image (every estimator accepts it).
-  const bool colour_frames = needs_images && config.source.type != SourceType::kV4l2;
+  // Colour slots where the source delivers colour (KITTI replay; V4L2 YUYV with
+  // source.v4l2.left_color); otherwise the image providers get the grey left image.
+  const bool colour_frames =
+      needs_images && (config.source.type != SourceType::kV4l2 || config.source.v4l2.left_color);
   frame_options.color = colour_frames;  // the capture thread copies left_color for the provider
   auto pool = runtime::FramePool::create(frame_options);
   if (!pool) return pool.status();
@@ -206,7 +208,10 @@ Expected<std::unique_ptr<RoverApp>> RoverApp::create(const RoverConfig& config,
       return Status(opened.status().code(), "telemetry.pose_log: " + opened.status().message());
     pose_log = std::move(*opened);
   }
-  if (link) link->setWorldOrigin(world->origin.lat_deg, world->origin.lon_deg, world->origin.alt_m);
+  if (link) {
+    link->setWorldOrigin(world->origin.lat_deg, world->origin.lon_deg, world->origin.alt_m);
+    link->setCameraMount(bodyFromCamera(config.body, impl->source->C_c_l()));
+  }
   impl->telemetry =
       std::make_unique<TelemetryStage>(*impl->ctx, std::move(link), std::move(pose_log));
   const auto warmup = static_cast<std::uint64_t>(config.realtime.warmup_frames);
