@@ -191,6 +191,11 @@ TEST(CalibrationFormat, DetectedByContent) {
   const std::string opencv = dir.file("stereo.yaml");
   writeOpenCv(opencv, "K1");
   EXPECT_EQ(*detectFormat(kitti, CalibrationFormat::kAuto), CalibrationFormat::kKitti);
+  // The package's placeholder (config/debian/calib_cam_to_cam.txt) stays a KITTI file, so its
+  // error is still the KITTI reader's.
+  const std::string placeholder =
+      std::string(SUNVO_SOURCE_DIR) + "/config/debian/calib_cam_to_cam.txt";
+  EXPECT_EQ(*detectFormat(placeholder, CalibrationFormat::kAuto), CalibrationFormat::kKitti);
   EXPECT_EQ(*detectFormat(opencv, CalibrationFormat::kAuto), CalibrationFormat::kOpenCv);
   EXPECT_EQ(*detectFormat(opencv, CalibrationFormat::kKalibr), CalibrationFormat::kKalibr);
   auto raw = readRawStereoCalibration(kitti, CalibrationFormat::kAuto);

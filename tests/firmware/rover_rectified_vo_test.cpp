@@ -4,7 +4,8 @@
 // V4l2FrameSource (driver, strobe pairing, calib::StereoRectifier), and the same stereo VO runs on
 // its output and on the original rectified frames. Issue 17's criterion: the live path's VO
 // within 5 % of the originals' (every per-frame translation and the whole displacement), and the
-// same rotations. The source also allocates nothing per frame once warm.
+// same rotations. The source also allocates nothing per frame once warm, and YUYV colour
+// reaches the colour Sun-CNN.
 
 #include <gtest/gtest.h>
 
@@ -19,6 +20,8 @@
 #include "sunvo/files/trajectory_io.hpp"
 #include "sunvo/pipeline/stereo_image_odometry.hpp"
 #include "sunvo/rover/device_sources.hpp"
+#include "sunvo/rover/sun_provider.hpp"
+#include "sunvo/sunestimators/sun_estimators.hpp"
 
 #if defined(SUNVO_HAVE_ALLOC_COUNTER)
 #include "sunvo/runtime/alloc_counter.hpp"
@@ -307,6 +310,68 @@ TEST(RoverRectifiedVo, LivePathOnRawFramesMatchesVoOnTheRectifiedOriginals) {
   std::printf("control, raw frames unrectified: %d of %zu frames lost, worst pair length %.1f %%\n",
               lost_raw, raw.size(), 100.0 * raw_len);
   EXPECT_TRUE(lost_raw > 0 || raw_len > 0.05);
+}
+
+// YUYV cameras with source.v4l2.left_color: the left image reaches the slot in colour,
+// rectified, and the colour Sun-CNN model (config/sun_cnn.onnx, 3 channels) runs on it; without
+// left_color the model gets the grey image (its luma copied to the three channels).
+TEST(RoverRectifiedVo, YuyvColourFeedsTheColourSunCnn) {
+  testing::TempDir dir;
+  auto data = testing::loadKittiFirstFrames();
+  ASSERT_TRUE(data.hasValue()) << data.status().toString();
+  StereoCamera cam = data->camera;
+  cam.width = 1240;  // YUYV carries pixels in pairs
+  const RawRig rig(cam);
+  const std::string yaml = dir.file("rig.yaml");
+  rig.writeOpenCvYaml(yaml);
+  const cv::Rect even(0, 0, cam.width, cam.height);
+  for (const bool colour : {false, true}) {
+    emulated::EmulatedV4l2 cameras;
+    ASSERT_TRUE(cameras
+                    .addCamera({"/dev/sunvo-left", cam.width, cam.height, false, true, 0, 0,
+                                emulated::imageSequence({data->frames[0].left(even).clone()})})
+                    .isOk());
+    ASSERT_TRUE(cameras
+                    .addCamera({"/dev/sunvo-right", cam.width, cam.height, false, true, 0, 0,
+                                emulated::imageSequence({data->frames[0].right(even).clone()})})
+                    .isOk());
+    RoverConfig config = liveConfig(yaml, rig.size);
+    config.source.v4l2.pixel_format = v4l2::V4l2PixelFormat::kYuyv;
+    config.source.v4l2.left_color = colour;
+    auto source = V4l2FrameSource::open(config, cameras, 0);
+    ASSERT_TRUE(source.hasValue()) << source.status().toString();
+    runtime::FrameSlot slot;
+    const TriggerEvent ev{0, kT0, kT0};
+    cameras.trigger(kT0 + kDelay);
+    ASSERT_TRUE((*source)->grab(ev, slot).isOk());
+    EXPECT_EQ(slot.frame.left_color.empty(), !colour);
+    if (colour) {
+      EXPECT_EQ(slot.frame.left_color.type(), CV_8UC3);
+      EXPECT_EQ(slot.frame.left_color.size(), rig.size);
+    }
+    SunConfig sun;
+    sun.provider = SunProviderType::kSunCnn;
+    sun.model = std::string(SUNVO_SOURCE_DIR) + "/config/sun_cnn.onnx";
+    auto provider = makeSunProvider(sun, (*source)->camera());
+    ASSERT_TRUE(provider.hasValue()) << provider.status().toString();
+    SunQuery q;
+    q.images = &slot.frame;
+    auto m = (*provider)->measure(q);  // the provider's path: no error, colour or grey
+    ASSERT_TRUE(m.hasValue()) << "colour " << colour << ": " << m.status().toString();
+    if (!colour) continue;
+    // The colour image carries more than its luma to the network: its answer differs from the
+    // grey image's (the emulator's chroma is not a sky's).
+    auto cnn = sunestimators::makeSunEstimator("sun_cnn", sun.model);
+    ASSERT_TRUE(cnn.hasValue()) << cnn.status().toString();
+    const StereoCamera camera = (*source)->camera();
+    auto from_colour = (*cnn)->estimate({slot.frame.left_color, camera, std::nullopt});
+    auto from_grey = (*cnn)->estimate({slot.frame.left, camera, std::nullopt});
+    ASSERT_TRUE(from_colour.hasValue()) << from_colour.status().toString();
+    ASSERT_TRUE(from_grey.hasValue()) << from_grey.status().toString();
+    std::printf("colour Sun-CNN azimuth: %.2f deg from the colour image, %.2f deg from grey\n",
+                from_colour->azimuth_deg, from_grey->azimuth_deg);
+    EXPECT_GT(std::abs(from_colour->azimuth_deg - from_grey->azimuth_deg), 0.01);
+  }
 }
 
 TEST(RoverRectifiedVo, RectifyingSourceAllocatesNothingPerFrame) {

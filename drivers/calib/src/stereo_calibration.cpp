@@ -342,7 +342,8 @@ Expected<CalibrationFormat> detectFormat(const std::string& path, CalibrationFor
   std::ostringstream text;
   text << in.rdbuf();
   const std::string s = text.str();
-  if (s.find("P_rect_00") != std::string::npos) return CalibrationFormat::kKitti;
+  const bool txt = path.size() >= 4 && path.compare(path.size() - 4, 4, ".txt") == 0;
+  if (txt || s.find("P_rect_00") != std::string::npos) return CalibrationFormat::kKitti;
   const bool top_cam0 = s.rfind("cam0:", 0) == 0 || s.find("\ncam0:") != std::string::npos;
   if (top_cam0 && s.find("intrinsics") != std::string::npos) return CalibrationFormat::kKalibr;
   return CalibrationFormat::kOpenCv;

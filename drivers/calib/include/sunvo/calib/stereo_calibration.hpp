@@ -67,7 +67,7 @@ struct RawStereoCalibration {
 Expected<RawStereoCalibration> readOpenCvStereo(const std::string& path);
 // Reads a Kalibr camchain.yaml (cam0, cam1).
 Expected<RawStereoCalibration> readKalibrCamchain(const std::string& path);
-// kAuto: by content. "P_rect_00" -> kKitti; a top-level "cam0:" with "intrinsics:" -> kKalibr;
+// kAuto: a name ending in ".txt" or a "P_rect_00" in the text -> kKitti; a top-level "cam0:" with "intrinsics:" -> kKalibr;
 // otherwise kOpenCv. Other formats are returned as given.
 Expected<CalibrationFormat> detectFormat(const std::string& path, CalibrationFormat format);
 // Reads a raw calibration in the given (or detected) format; kKitti is refused (not raw).
