@@ -19,16 +19,23 @@ template <int kChannels>
 void remapBilinear(const cv::Mat& src, const cv::Mat& map1, const cv::Mat& map2, cv::Mat& dst) {
   constexpr int kBits = cv::INTER_BITS;  // 5
   constexpr int kTab = 1 << kBits;       // 32
+  // Locals, not Mat fields: the byte stores below may alias anything, and would make the
+  // compiler reload src's fields for every pixel.
   const int w = src.cols;
   const int h = src.rows;
+  const std::uint8_t* const data = src.data;
+  const std::size_t step = src.step[0];
+  const int cols = dst.cols;
   const auto pixel = [&](int x, int y, int c) -> int {
-    return (x >= 0 && y >= 0 && x < w && y < h) ? src.ptr<std::uint8_t>(y)[x * kChannels + c] : 0;
+    return (x >= 0 && y >= 0 && x < w && y < h) ? data[static_cast<std::size_t>(y) * step +
+                                                       static_cast<std::size_t>(x * kChannels + c)]
+                                                : 0;
   };
   for (int v = 0; v < dst.rows; ++v) {
     const auto* xy = map1.ptr<std::int16_t>(v);
     const auto* frac = map2.ptr<std::uint16_t>(v);
     std::uint8_t* out = dst.ptr<std::uint8_t>(v);
-    for (int u = 0; u < dst.cols; ++u, out += kChannels) {
+    for (int u = 0; u < cols; ++u, out += kChannels) {
       const int x = xy[2 * u];
       const int y = xy[2 * u + 1];
       const int fx = frac[u] & (kTab - 1);
@@ -38,8 +45,8 @@ void remapBilinear(const cv::Mat& src, const cv::Mat& map1, const cv::Mat& map2,
       const int w10 = (kTab - fx) * fy;
       const int w11 = fx * fy;
       if (x >= 0 && y >= 0 && x + 1 < w && y + 1 < h) {
-        const std::uint8_t* p0 = src.ptr<std::uint8_t>(y) + x * kChannels;
-        const std::uint8_t* p1 = p0 + src.step[0];
+        const std::uint8_t* p0 = data + static_cast<std::size_t>(y) * step + x * kChannels;
+        const std::uint8_t* p1 = p0 + step;
         for (int c = 0; c < kChannels; ++c) {
           const int sum =
               p0[c] * w00 + p0[kChannels + c] * w01 + p1[c] * w10 + p1[kChannels + c] * w11;
