@@ -55,8 +55,7 @@ TEST(OpenCvStereo, ReadsWhatFileStorageWrote) {
 TEST(OpenCvStereo, ReadsHandWrittenListsAndFisheye) {
   TempDir dir;
   const std::string path = dir.file("rig.yml");
-  writeText(path,
-            "%YAML:1.0\n"
+  writeText(path,  // no "%YAML" line: OpenCV alone would refuse it
             "M1: [700, 0, 320, 0, 702, 240, 0, 0, 1]\n"
             "D1: [0.01, -0.002, 0.0003, 0.0]\n"
             "M2: [705, 0, 318, 0, 706, 243, 0, 0, 1]\n"
@@ -114,6 +113,15 @@ TEST(OpenCvStereo, ErrorsNameTheFileAndTheKey) {
   auto r = readOpenCvStereo(bad_r);
   ASSERT_FALSE(r.hasValue());
   EXPECT_NE(r.status().message().find("bad_r.yaml: R"), std::string::npos) << r.status().message();
+
+  // A malformed matrix makes cv::FileStorage throw: an error, not an exception.
+  const std::string bad_dt = dir.file("bad_dt.yaml");
+  writeText(bad_dt,
+            "%YAML:1.0\nK1: !!opencv-matrix\n  rows: 3\n  cols: 3\n  dt: zz\n"
+            "  data: [1, 2, 3]\n");
+  auto dt = readOpenCvStereo(bad_dt);
+  ASSERT_FALSE(dt.hasValue());
+  EXPECT_NE(dt.status().message().find("bad_dt.yaml"), std::string::npos) << dt.status().message();
 
   auto none = readOpenCvStereo(dir.file("absent.yaml"));
   ASSERT_FALSE(none.hasValue());
@@ -182,6 +190,33 @@ TEST(KalibrCamchain, ErrorsNameTheFileTheKeyAndTheLine) {
   ASSERT_FALSE(m.hasValue());
   EXPECT_NE(m.status().message().find("mono.yaml: cam1"), std::string::npos)
       << m.status().message();
+}
+
+// Whatever the file holds, both readers answer with a Status (no exception, no crash).
+TEST(CalibrationReaders, GarbageIsAnErrorNotAnException) {
+  TempDir dir;
+  const std::string inputs[] = {
+      "",
+      "\x01\x02\xff\xfe binary",
+      "- [1, 2]\n- 3\n",
+      "%YAML:1.0\nK1: {a: 1}\n",
+      "<?xml version=\"1.0\"?>\n<opencv_storage><K1>1 2",
+      "cam0: [1, 2]\ncam1: 7\n",
+      "cam0:\n  intrinsics: [a, b, c, d]\n",
+      "{\"K1\": [1, 2, 3, 4, 5, 6, 7, 8, 9], \"D1\": \"x\"}",
+      "%YAML:1.0\nK1: !!opencv-matrix\n  rows: 100000\n  cols: 100000\n  dt: d\n  data: [1]\n",
+  };
+  int k = 0;
+  for (const std::string& text : inputs) {
+    const std::string path = dir.file("garbage_" + std::to_string(k++) + ".yaml");
+    writeText(path, text);
+    auto a = readOpenCvStereo(path);
+    auto b = readKalibrCamchain(path);
+    EXPECT_FALSE(a.hasValue()) << text;
+    EXPECT_FALSE(b.hasValue()) << text;
+    EXPECT_NE(a.status().message().find("garbage_"), std::string::npos) << a.status().message();
+    EXPECT_NE(b.status().message().find("garbage_"), std::string::npos) << b.status().message();
+  }
 }
 
 TEST(CalibrationFormat, DetectedByContent) {

@@ -142,6 +142,33 @@ cv::Mat rowOf(const std::vector<double>& v) {
   return cv::Mat(1, static_cast<int>(v.size()), CV_64F, const_cast<double*>(v.data())).clone();
 }
 
+// Every key of an OpenCV stereo file into c (may throw cv::Exception).
+Status readOpenCvFields(const cv::FileStorage& fs, const std::string& path,
+                        RawStereoCalibration* c) {
+  std::vector<double> v;
+  SUNVO_RETURN_IF_ERROR(
+      readNumbers(fs, path, {"K1", "M1", "cameraMatrix1", "camera_matrix_left"}, {9}, &v));
+  c->K_left = toMatx33(v);
+  SUNVO_RETURN_IF_ERROR(
+      readNumbers(fs, path, {"K2", "M2", "cameraMatrix2", "camera_matrix_right"}, {9}, &v));
+  c->K_right = toMatx33(v);
+  if (const cv::FileNode m = fs["distortion_model"]; !m.empty()) {
+    if (!m.isString()) return keyError(path, "distortion_model", "expected a name");
+    SUNVO_RETURN_IF_ERROR(readModel(path, "distortion_model", m.string(), &c->model));
+  }
+  SUNVO_RETURN_IF_ERROR(
+      readNumbers(fs, path, {"D1", "distCoeffs1", "dist_coeffs_left"}, {4, 5, 8, 12, 14}, &v));
+  c->D_left = rowOf(v);
+  SUNVO_RETURN_IF_ERROR(
+      readNumbers(fs, path, {"D2", "distCoeffs2", "dist_coeffs_right"}, {4, 5, 8, 12, 14}, &v));
+  c->D_right = rowOf(v);
+  SUNVO_RETURN_IF_ERROR(readNumbers(fs, path, {"R"}, {9}, &v));
+  c->C_r_l = toMatx33(v);
+  SUNVO_RETURN_IF_ERROR(readNumbers(fs, path, {"T"}, {3}, &v));
+  c->t_r_l = cv::Vec3d(v[0], v[1], v[2]);
+  return readImageSize(fs, path, &c->size);
+}
+
 // --- Kalibr (yaml-cpp) -------------------------------------------------------------------------
 
 std::string line(const YAML::Node& n) {
@@ -262,36 +289,31 @@ Status RawStereoCalibration::validate() const {
 }
 
 Expected<RawStereoCalibration> readOpenCvStereo(const std::string& path) {
-  cv::FileStorage fs;
-  try {
-    if (!fs.open(path, cv::FileStorage::READ)) return ioError(path + ": cannot open");
-  } catch (const cv::Exception& e) {
-    return parseError(path + ": not an OpenCV YAML/XML file: " + e.msg);
-  }
   RawStereoCalibration c;
   c.file = path;
-  std::vector<double> v;
-  SUNVO_RETURN_IF_ERROR(
-      readNumbers(fs, path, {"K1", "M1", "cameraMatrix1", "camera_matrix_left"}, {9}, &v));
-  c.K_left = toMatx33(v);
-  SUNVO_RETURN_IF_ERROR(
-      readNumbers(fs, path, {"K2", "M2", "cameraMatrix2", "camera_matrix_right"}, {9}, &v));
-  c.K_right = toMatx33(v);
-  if (const cv::FileNode m = fs["distortion_model"]; !m.empty()) {
-    if (!m.isString()) return keyError(path, "distortion_model", "expected a name");
-    SUNVO_RETURN_IF_ERROR(readModel(path, "distortion_model", m.string(), &c.model));
+  // cv::FileStorage throws on a malformed file and on a malformed !!opencv-matrix (bad dt,
+  // data that does not fit rows x cols): an error naming the file, never an exception out.
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return ioError(path + ": cannot open");
+  std::ostringstream whole;
+  whole << in.rdbuf();
+  std::string text = whole.str();
+  // OpenCV 4.6 reads YAML only after a "%YAML" line ("Input file is invalid" otherwise); a
+  // hand-written file without one is read as YAML too.
+  const std::size_t first = text.find_first_not_of(" \t\r\n");
+  const bool has_signature =
+      first != std::string::npos && (text.compare(first, 5, "%YAML") == 0 ||
+                                     text.compare(first, 5, "<?xml") == 0 || text[first] == '{');
+  if (!has_signature) text = "%YAML:1.0\n" + text;
+  try {
+    cv::FileStorage fs;
+    if (!fs.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY)) {
+      return parseError(fileName(path) + ": not a readable OpenCV YAML/XML file");
+    }
+    SUNVO_RETURN_IF_ERROR(readOpenCvFields(fs, path, &c));
+  } catch (const cv::Exception& e) {
+    return parseError(fileName(path) + ": not a readable OpenCV YAML/XML file: " + e.msg);
   }
-  SUNVO_RETURN_IF_ERROR(
-      readNumbers(fs, path, {"D1", "distCoeffs1", "dist_coeffs_left"}, {4, 5, 8, 12, 14}, &v));
-  c.D_left = rowOf(v);
-  SUNVO_RETURN_IF_ERROR(
-      readNumbers(fs, path, {"D2", "distCoeffs2", "dist_coeffs_right"}, {4, 5, 8, 12, 14}, &v));
-  c.D_right = rowOf(v);
-  SUNVO_RETURN_IF_ERROR(readNumbers(fs, path, {"R"}, {9}, &v));
-  c.C_r_l = toMatx33(v);
-  SUNVO_RETURN_IF_ERROR(readNumbers(fs, path, {"T"}, {3}, &v));
-  c.t_r_l = cv::Vec3d(v[0], v[1], v[2]);
-  SUNVO_RETURN_IF_ERROR(readImageSize(fs, path, &c.size));
   const Status s = c.validate();
   if (!s.isOk()) return s;
   return c;
@@ -309,14 +331,18 @@ Expected<RawStereoCalibration> readKalibrCamchain(const std::string& path) {
   if (!root.IsMap()) return parseError(fileName(path) + ": not a Kalibr camchain (no map)");
   KalibrCamera left;
   KalibrCamera right;
-  SUNVO_RETURN_IF_ERROR(readKalibrCamera(root, path, "cam0", &left));
-  SUNVO_RETURN_IF_ERROR(readKalibrCamera(root, path, "cam1", &right));
+  std::vector<double> T;
+  try {
+    SUNVO_RETURN_IF_ERROR(readKalibrCamera(root, path, "cam0", &left));
+    SUNVO_RETURN_IF_ERROR(readKalibrCamera(root, path, "cam1", &right));
+    SUNVO_RETURN_IF_ERROR(kalibrNumbers(root["cam1"], path, "cam1", "T_cn_cnm1", 16, &T));
+  } catch (const YAML::Exception& e) {
+    return parseError(fileName(path) + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
+  }
   if (left.model != right.model) {
     return keyError(path, "cam1.distortion_model", "differs from cam0's");
   }
   if (left.size != right.size) return keyError(path, "cam1.resolution", "differs from cam0's");
-  std::vector<double> T;
-  SUNVO_RETURN_IF_ERROR(kalibrNumbers(root["cam1"], path, "cam1", "T_cn_cnm1", 16, &T));
   if (std::abs(T[12]) + std::abs(T[13]) + std::abs(T[14]) > 1e-9 || std::abs(T[15] - 1.0) > 1e-9) {
     return keyError(path, "cam1.T_cn_cnm1", "last row must be [0, 0, 0, 1]");
   }

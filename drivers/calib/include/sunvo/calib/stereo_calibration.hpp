@@ -3,8 +3,9 @@
 // write. Two formats:
 //
 // OpenCV stereo YAML, read with cv::FileStorage (the layout of OpenCV's stereo_calib sample and
-// of most scripts around cv::stereoCalibrate). Matrices as !!opencv-matrix or as flat lists of
-// numbers, row-major. Accepted keys (the first spelling present wins):
+// of most scripts around cv::stereoCalibrate; a YAML file without the "%YAML" line OpenCV wants
+// is read too). Matrices as !!opencv-matrix or as flat lists of numbers, row-major. Accepted keys
+// (the first spelling present wins):
 //   left intrinsics   K1 | M1 | cameraMatrix1 | camera_matrix_left      3x3
 //   left distortion   D1 | distCoeffs1 | dist_coeffs_left               4, 5, 8, 12 or 14 values
 //   right             K2 | M2 | cameraMatrix2 | camera_matrix_right, D2 | distCoeffs2 | ...right
@@ -67,8 +68,8 @@ struct RawStereoCalibration {
 Expected<RawStereoCalibration> readOpenCvStereo(const std::string& path);
 // Reads a Kalibr camchain.yaml (cam0, cam1).
 Expected<RawStereoCalibration> readKalibrCamchain(const std::string& path);
-// kAuto: a name ending in ".txt" or a "P_rect_00" in the text -> kKitti; a top-level "cam0:" with "intrinsics:" -> kKalibr;
-// otherwise kOpenCv. Other formats are returned as given.
+// kAuto: a name ending in ".txt" or a "P_rect_00" in the text -> kKitti; a top-level "cam0:" with
+// "intrinsics:" -> kKalibr; otherwise kOpenCv. Other formats are returned as given.
 Expected<CalibrationFormat> detectFormat(const std::string& path, CalibrationFormat format);
 // Reads a raw calibration in the given (or detected) format; kKitti is refused (not raw).
 Expected<RawStereoCalibration> readRawStereoCalibration(const std::string& path,
