@@ -338,6 +338,8 @@ TEST(RoverRectifiedVo, YuyvColourFeedsTheColourSunCnn) {
     RoverConfig config = liveConfig(yaml, rig.size);
     config.source.v4l2.pixel_format = v4l2::V4l2PixelFormat::kYuyv;
     config.source.v4l2.left_color = colour;
+    config.sun.provider =
+        SunProviderType::kSunCnn;  // colour is converted only for an image provider
     auto source = V4l2FrameSource::open(config, cameras, 0);
     ASSERT_TRUE(source.hasValue()) << source.status().toString();
     runtime::FrameSlot slot;

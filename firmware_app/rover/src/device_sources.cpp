@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "sunvo/kitti/calibration.hpp"
+#include "sunvo/rover/sun_provider.hpp"
 
 namespace sunvo::rover {
 
@@ -76,7 +77,9 @@ Expected<std::unique_ptr<V4l2FrameSource>> V4l2FrameSource::open(const RoverConf
   vo.left_device = c.left_device;
   vo.right_device = c.right_device;
   vo.pixel_format = c.pixel_format;
-  vo.left_color = c.left_color;
+  // Colour only for a provider that looks at images (the frame pool has colour slots then).
+  const bool colour = c.left_color && sunProviderNeedsImages(config.sun.provider);
+  vo.left_color = colour;
   vo.width = config.frames.width;
   vo.height = config.frames.height;
   vo.fps = config.trigger.rate_hz;
@@ -99,7 +102,7 @@ Expected<std::unique_ptr<V4l2FrameSource>> V4l2FrameSource::open(const RoverConf
     const cv::Size size(config.frames.width, config.frames.height);
     s->raw_.left.create(size, CV_8UC1);
     s->raw_.right.create(size, CV_8UC1);
-    if (c.left_color) s->raw_.left_color.create(size, CV_8UC3);
+    if (colour) s->raw_.left_color.create(size, CV_8UC3);
     s->rectifier_ = std::move(rectifier);
   }
   s->camera_source_ = std::move(*cam);

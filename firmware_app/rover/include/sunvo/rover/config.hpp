@@ -107,8 +107,9 @@ struct V4l2SourceConfig {
   calib::RectifyOptions rectify;  // raw calibrations: rectify.alpha, [0, 1]
   v4l2::V4l2Layout layout = v4l2::V4l2Layout::kTwoDevices;            // two_devices | side_by_side
   v4l2::V4l2PixelFormat pixel_format = v4l2::V4l2PixelFormat::kGrey;  // grey | yuyv
-  // yuyv only: also the left image in colour (BGR) for an image sun provider that needs colour
-  // (the colour Sun-CNN model); off: the providers get the grey image.
+  // yuyv only: also the left image in colour (BGR) for the image sun providers (the colour
+  // Sun-CNN model needs it; converted only when sun.provider looks at images); off: the
+  // providers get the grey image.
   bool left_color = false;
   int buffer_count = 4;          // MMAP buffers per device, [2, 32]
   int dequeue_timeout_ms = 200;  // ms, [1, 60000]: the longest wait for one stereo pair
