@@ -16,10 +16,13 @@
 #include "../support/kitti_first_frames.hpp"
 #include "../support/temp_dir.hpp"
 #include "sunvo/core/geometry.hpp"
+#include "sunvo/emulated/emulated_gpio.hpp"
 #include "sunvo/emulated/emulated_v4l2.hpp"
 #include "sunvo/files/trajectory_io.hpp"
 #include "sunvo/pipeline/stereo_image_odometry.hpp"
+#include "sunvo/rover/app.hpp"
 #include "sunvo/rover/device_sources.hpp"
+#include "sunvo/rover/mavlink_link.hpp"
 #include "sunvo/rover/sun_provider.hpp"
 #include "sunvo/sunestimators/sun_estimators.hpp"
 
@@ -374,6 +377,77 @@ TEST(RoverRectifiedVo, YuyvColourFeedsTheColourSunCnn) {
                 from_colour->azimuth_deg, from_grey->azimuth_deg);
     EXPECT_GT(std::abs(from_colour->azimuth_deg - from_grey->azimuth_deg), 0.01);
   }
+}
+
+// A PoseLink that keeps what RoverApp::create hands it before the stream starts.
+class MountRecorder final : public PoseLink {
+ public:
+  Status sendPose(const PoseRecord&, TimeNs) override { return Status::ok(); }
+  Status sendHeartbeat(TimeNs) override { return Status::ok(); }
+  Status service(TimeNs) override { return Status::ok(); }
+  bool drained() const override { return true; }
+  TimeNs lastByteWrittenNs() const override { return 0; }
+  std::string countersText() const override { return "mount recorder"; }
+  void setCameraMount(const Isometry3& T_b_c) override {
+    T_b_c_ = T_b_c;
+    mounted_ = true;
+  }
+  Isometry3 T_b_c_ = Isometry3::Identity();
+  bool mounted_ = false;
+};
+
+// The program's wiring (RoverApp::create from config/rover.yaml with a raw calibration): the
+// estimator's camera is the rectified one, and the link gets T_b_c from body.* and the
+// rectification's rotation.
+TEST(RoverRectifiedVo, TheProgramRectifiesAndMountsTheCamera) {
+  Fixture fx;
+  fx.setUp();
+  if (HasFatalFailure()) return;
+  const std::string yaml = fx.dir.file("rig.yaml");
+  emulated::EmulatedGpio gpio;
+  ASSERT_TRUE(gpio.addChip("gpiochip0", 32).isOk());
+  auto config = loadRoverConfig(std::string(SUNVO_SOURCE_DIR) + "/config/rover.yaml",
+                                {{"source.v4l2.calibration", yaml},
+                                 {"frames.width", std::to_string(fx.data.camera.width)},
+                                 {"frames.height", std::to_string(fx.data.camera.height)},
+                                 {"body.camera_pitch_deg", "-15"},
+                                 {"body.camera_x_m", "0.42"},
+                                 {"body.camera_z_m", "-0.3"},
+                                 {"serial.device", "\"\""},
+                                 {"rt.lock_memory", "false"},
+                                 {"rt.heap_reserve_mb", "0"},
+                                 {"profiling.output_dir", fx.dir.file("out")}});
+  ASSERT_TRUE(config.hasValue()) << config.status().toString();
+  // The camera nodes are taken by the fixture's source: a second rig for the program.
+  emulated::EmulatedV4l2 cameras;
+  const cv::Size size(fx.data.camera.width, fx.data.camera.height);
+  ASSERT_TRUE(cameras
+                  .addCamera({"/dev/sunvo-left", size.width, size.height, true, false, 0, 0,
+                              emulated::imageSequence(fx.raw_left)})
+                  .isOk());
+  ASSERT_TRUE(cameras
+                  .addCamera({"/dev/sunvo-right", size.width, size.height, true, false, 0, 0,
+                              emulated::imageSequence(fx.raw_right)})
+                  .isOk());
+  auto link = std::make_unique<MountRecorder>();
+  MountRecorder* recorder = link.get();
+  auto app = RoverApp::create(*config, std::move(link), RoverDevices{&cameras, &gpio});
+  ASSERT_TRUE(app.hasValue()) << app.status().toString();
+  ASSERT_TRUE(recorder->mounted_);
+  const Isometry3 expected = bodyFromCamera(config->body, fx.source->C_c_l());
+  EXPECT_TRUE(recorder->T_b_c_.isApprox(expected, 1e-12));
+  EXPECT_TRUE(recorder->T_b_c_.translation().isApprox(Eigen::Vector3d(0.42, 0.0, -0.3)));
+  // Not the unrectified mount: the rectification turned the camera.
+  const Isometry3 raw_mount = bodyFromCamera(config->body, Eigen::Matrix3d::Identity());
+  EXPECT_GT((recorder->T_b_c_.linear() - raw_mount.linear()).norm(), 1e-3);
+  const std::string summary = (*app)->summary();
+  char line[160];
+  const StereoCamera& cam = fx.source->camera();
+  std::snprintf(
+      line, sizeof(line),
+      "camera %dx%d: fu %.2f fv %.2f cu %.2f cv %.2f px, baseline %.4f m (rectified here)",
+      cam.width, cam.height, cam.fu, cam.fv, cam.cu, cam.cv, cam.baseline_m);
+  EXPECT_NE(summary.find(line), std::string::npos) << summary;
 }
 
 TEST(RoverRectifiedVo, RectifyingSourceAllocatesNothingPerFrame) {
