@@ -12,8 +12,9 @@ namespace {
 // Bilinear remap with cv::initUndistortRectifyMap's fixed-point maps (map1 CV_16SC2: the integer
 // source pixel (x, y); map2 CV_16UC1: the fraction as fy * 32 + fx in 1/32 px), black outside the
 // source. cv::remap computes the same (its 8-bit tables differ in rounding by at most one grey
-// level) but allocates two block buffers per call (RemapInvoker; 4 allocations per call measured
-// with OpenCV 4.6), so a frame could not be allocation-free through it.
+// level) but allocates block buffers on every call (RemapInvoker; 28 allocations for one 1242x375
+// image with OpenCV 4.6, tests/calib/rectifier_test.cpp), so a frame could not be allocation-free
+// through it.
 // With weights w = (32 - f) or f per axis, out = (sum of w_x w_y * pixel + 512) >> 10.
 template <int kChannels>
 void remapBilinear(const cv::Mat& src, const cv::Mat& map1, const cv::Mat& map2, cv::Mat& dst) {
