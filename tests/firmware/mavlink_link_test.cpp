@@ -263,6 +263,53 @@ void checkCommon(const StreamRun& run) {
   EXPECT_GT(r.odometry[39].pose_covariance[0], 4.0f * r.odometry[1].pose_covariance[0]);
 }
 
+// body.*: the mount turns the forward-looking camera about the body axes, the rectification's
+// rotation is undone, and the lever arm moves position and velocity to the body origin.
+TEST(MavlinkLink, CameraMountAndLeverArmGiveTheBodyPose) {
+  constexpr double kDeg = M_PI / 180.0;
+  const Eigen::Vector3d optical_axis_c(0, 0, 1);
+  BodyConfig body;
+  Isometry3 T_b_c = bodyFromCamera(body, Eigen::Matrix3d::Identity());
+  EXPECT_TRUE(T_b_c.linear().isApprox(mavlink::cameraForwardC_b_c()));
+  EXPECT_TRUE(T_b_c.translation().isZero());
+  body.camera_yaw_deg = 90.0;  // looking right: the optical axis is body y
+  EXPECT_TRUE((bodyFromCamera(body, Eigen::Matrix3d::Identity()).linear() * optical_axis_c)
+                  .isApprox(Eigen::Vector3d::UnitY()));
+  body.camera_yaw_deg = 0.0;
+  body.camera_pitch_deg = 10.0;  // tilted up: -z is up in FRD
+  const Eigen::Vector3d up =
+      bodyFromCamera(body, Eigen::Matrix3d::Identity()).linear() * optical_axis_c;
+  EXPECT_NEAR(up.z(), -std::sin(10.0 * kDeg), 1e-12);
+  EXPECT_NEAR(up.x(), std::cos(10.0 * kDeg), 1e-12);
+  // A rectified camera c turned from the physical one l: C_b_c = C_b_l C_c_l^T.
+  const Eigen::Matrix3d C_c_l =
+      Eigen::AngleAxisd(0.02, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  body.camera_pitch_deg = 0.0;
+  body.camera_x_m = 0.5;
+  body.camera_z_m = -0.2;
+  T_b_c = bodyFromCamera(body, C_c_l);
+  EXPECT_TRUE((T_b_c.linear() * C_c_l).isApprox(mavlink::cameraForwardC_b_c()));
+  EXPECT_TRUE(T_b_c.translation().isApprox(Eigen::Vector3d(0.5, 0.0, -0.2)));
+
+  // Lever arm: the body origin's pose is T_w_b = T_w_c T_c_b; its velocity is the camera's plus
+  // omega x r for the rigid arm.
+  mavlink::OdometryInput in;
+  in.T_w_c.linear() =
+      Eigen::AngleAxisd(0.7, Eigen::Vector3d(0.2, -1.0, 0.3).normalized()).toRotationMatrix();
+  in.T_w_c.translation() = Eigen::Vector3d(10.0, -4.0, 2.0);
+  in.v_w = Eigen::Vector3d(1.0, 0.5, 0.0);
+  in.omega_c = Eigen::Vector3d(0.0, 0.3, 0.0);
+  const Isometry3 T_w_b = in.T_w_c * T_b_c.inverse();
+  moveToBodyOrigin(T_b_c.translation(), T_b_c.linear(), &in);
+  EXPECT_TRUE(in.T_w_c.translation().isApprox(T_w_b.translation(), 1e-12));
+  const Eigen::Vector3d t_c_b = T_b_c.inverse().translation();
+  const Eigen::Vector3d v_expected =
+      Eigen::Vector3d(1.0, 0.5, 0.0) +
+      in.T_w_c.linear() * Eigen::Vector3d(0.0, 0.3, 0.0).cross(t_c_b);
+  EXPECT_TRUE(in.v_w.isApprox(v_expected, 1e-12));
+  EXPECT_GT((in.v_w - Eigen::Vector3d(1.0, 0.5, 0.0)).norm(), 0.05);  // the arm is felt
+}
+
 TEST(MavlinkLink, Px4ProfilePassesPx4sOdometryHandler) {
   const StreamRun run = driveThroughPty(mavlink::FrameProfile::kPx4);
   checkCommon(run);

@@ -90,6 +90,53 @@ TEST(RoverConfig, DefaultsAndOverrides) {
   EXPECT_EQ(px4->telemetry.frame, mavlink::FrameProfile::kPx4);  // the default
 }
 
+// The raw-calibration, colour and camera-mount keys (docs/deployment.md, "Stereo calibration"):
+// read from the deployment file's V4L2 source, defaults that keep today's behaviour, and
+// errors naming the key.
+TEST(RoverConfig, CalibrationColourAndMountKeys) {
+  const std::string rover = std::string(SUNVO_SOURCE_DIR) + "/config/rover.yaml";
+  auto d = loadRoverConfig(rover);
+  ASSERT_TRUE(d) << d.status().toString();
+  EXPECT_EQ(d->source.v4l2.calibration_format, calib::CalibrationFormat::kAuto);
+  EXPECT_DOUBLE_EQ(d->source.v4l2.rectify.alpha, 0.0);
+  EXPECT_FALSE(d->source.v4l2.left_color);
+  EXPECT_DOUBLE_EQ(d->body.camera_x_m, 0.0);
+  auto c = loadRoverConfig(rover, {{"source.v4l2.calibration_format", "kalibr"},
+                                   {"source.v4l2.rectify.alpha", "0.25"},
+                                   {"source.v4l2.pixel_format", "yuyv"},
+                                   {"source.v4l2.left_color", "true"},
+                                   {"body.camera_pitch_deg", "-15"},
+                                   {"body.camera_x_m", "0.42"},
+                                   {"body.camera_z_m", "-0.3"}});
+  ASSERT_TRUE(c) << c.status().toString();
+  EXPECT_EQ(c->source.v4l2.calibration_format, calib::CalibrationFormat::kKalibr);
+  EXPECT_DOUBLE_EQ(c->source.v4l2.rectify.alpha, 0.25);
+  EXPECT_TRUE(c->source.v4l2.left_color);
+  EXPECT_DOUBLE_EQ(c->body.camera_pitch_deg, -15.0);
+  EXPECT_DOUBLE_EQ(c->body.camera_x_m, 0.42);
+  EXPECT_DOUBLE_EQ(c->body.camera_z_m, -0.3);
+  const std::string text = c->describe();
+  EXPECT_NE(text.find("  source.v4l2.calibration_format: kalibr\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("  source.v4l2.rectify.alpha: 0.25\n"), std::string::npos);
+  EXPECT_NE(text.find("  body.camera_x_m: 0.42\n"), std::string::npos);
+
+  const auto error = [&](const std::string& key, const std::string& value) {
+    auto bad = loadRoverConfig(rover, {{key, value}});
+    EXPECT_FALSE(bad) << key;
+    return bad ? std::string() : bad.status().message();
+  };
+  EXPECT_NE(error("source.v4l2.calibration_format", "ros")
+                .find("'ros' is not one of auto, kitti, "
+                      "opencv, kalibr"),
+            std::string::npos);
+  EXPECT_NE(error("source.v4l2.rectify.alpha", "1.5").find("source.v4l2.rectify.alpha"),
+            std::string::npos);
+  EXPECT_NE(error("source.v4l2.left_color", "true").find("source.v4l2.left_color: needs"),
+            std::string::npos);
+  EXPECT_NE(error("body.camera_pitch_deg", "95").find("body.camera_pitch_deg"), std::string::npos);
+  EXPECT_NE(error("body.camera_y_m", "200").find("body.camera_y_m"), std::string::npos);
+}
+
 // Found by fuzzing (tests/fuzz/fuzz_rover_yaml): a complex key ("? ...") made yaml-cpp throw out
 // of the reader, which ended the program; it is an error naming the file, line and section.
 TEST(RoverConfig, AComplexKeyIsAnErrorNotAnException) {

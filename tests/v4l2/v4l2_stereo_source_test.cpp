@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 #include <string>
 #include <vector>
 
@@ -233,6 +234,40 @@ TEST(V4l2StereoSource, YuyvConversionKeepsLumaAndIgnoresChroma) {
   EXPECT_TRUE(sameImage(frame.right, inverted));
 }
 
+// left_color: the left eye in BGR through cv::cvtColor(COLOR_YUV2BGR_YUYV) of the bytes the
+// camera sent (rebuilt here from the grey image and the emulator's chroma), in both layouts and
+// with line padding; the grey eyes stay the luma.
+TEST(V4l2StereoSource, YuyvLeftColourIsOpenCvsConversion) {
+  for (const V4l2Layout layout : {V4l2Layout::kTwoDevices, V4l2Layout::kSideBySide}) {
+    Rig rig(layout, /*line_padding=*/6);
+    V4l2Options o = fastOptions(layout, V4l2PixelFormat::kYuyv);
+    o.left_color = true;
+    auto source = openOrFail(o, rig.emu);
+    ASSERT_NE(source, nullptr);
+    rig.emu.trigger(kT0);
+    StereoFrame frame;
+    ASSERT_TRUE(source->next(frame).isOk());
+    cv::Mat yuyv(kH, kW, CV_8UC2);
+    for (int y = 0; y < kH; ++y) {
+      for (int x = 0; x < kW; x += 2) {
+        const std::uint8_t u = emulated::yuyvChroma(x, y);
+        yuyv.at<cv::Vec2b>(y, x) = {rig.left(0).at<std::uint8_t>(y, x), u};
+        yuyv.at<cv::Vec2b>(y, x + 1) = {rig.left(0).at<std::uint8_t>(y, x + 1),
+                                        static_cast<std::uint8_t>(255 - u)};
+      }
+    }
+    cv::Mat expected;
+    cv::cvtColor(yuyv, expected, cv::COLOR_YUV2BGR_YUYV);
+    EXPECT_TRUE(sameImage(frame.left_color, expected));
+    EXPECT_TRUE(sameImage(frame.left, rig.left(0)));
+    EXPECT_TRUE(sameImage(frame.right, rig.right(0)));
+    EXPECT_TRUE(frame.right_color.empty());
+  }
+  V4l2Options grey = fastOptions(V4l2Layout::kTwoDevices, V4l2PixelFormat::kGrey);
+  grey.left_color = true;
+  EXPECT_NE(grey.validate().message().find("v4l2.left_color"), std::string::npos);
+}
+
 TEST(V4l2StereoSource, FlaggedBufferIsRequeuedSkippedAndCounted) {
   for (V4l2Layout layout : {V4l2Layout::kTwoDevices, V4l2Layout::kSideBySide}) {
     Rig rig(layout);
@@ -458,11 +493,13 @@ TEST(V4l2StereoSource, NoHeapAllocationPerFrameAfterTheFirst) {
   for (V4l2Layout layout : {V4l2Layout::kTwoDevices, V4l2Layout::kSideBySide}) {
     for (V4l2PixelFormat format : {V4l2PixelFormat::kGrey, V4l2PixelFormat::kYuyv}) {
       Rig rig(layout);
-      auto source = openOrFail(fastOptions(layout, format), rig.emu);
+      V4l2Options o = fastOptions(layout, format);
+      o.left_color = format == V4l2PixelFormat::kYuyv;  // and the colour conversion
+      auto source = openOrFail(o, rig.emu);
       ASSERT_NE(source, nullptr);
       StereoFrame frame;
       rig.emu.trigger(kT0);
-      ASSERT_TRUE(source->next(frame).isOk());  // allocates frame.left / frame.right
+      ASSERT_TRUE(source->next(frame).isOk());  // allocates frame.left / right / left_color
       const void* left_data = frame.left.data;
       std::uint64_t allocations = 0;
       // More frames than a std::deque block holds (128 ints), so that a container growing in

@@ -7,6 +7,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <opencv2/imgproc.hpp>
 #include <utility>
 
 namespace sunvo::v4l2 {
@@ -63,6 +64,9 @@ Status V4l2Options::validate() const {
   if (pixel_format == V4l2PixelFormat::kYuyv && width % 2 != 0) {
     return invalidArgument("v4l2.width: " + std::to_string(width) +
                            " is odd; YUYV carries pixels in pairs");
+  }
+  if (left_color && pixel_format != V4l2PixelFormat::kYuyv) {
+    return invalidArgument("v4l2.left_color: needs pixel_format YUYV (GREY has no colour)");
   }
   if (!(fps > 0.0 && fps <= 1000.0)) {
     return invalidArgument("v4l2.fps: " + std::to_string(fps) + " is outside (0, 1000]");
@@ -321,6 +325,20 @@ void V4l2StereoSource::copyEye(const Device& d, const Held& held, int x0, cv::Ma
   }
 }
 
+void V4l2StereoSource::colorEye(const Device& d, const Held& held, cv::Mat& bgr) const {
+  auto* base = static_cast<std::uint8_t*>(d.buffers[held.index].addr);
+  // The left eye's YUYV pixels in place (2 bytes per pixel, the device's line stride). Converted
+  // in row bands of at most 2^16 pixels: cvtColor asks parallel_for_ for pixels / 2^16 stripes,
+  // so each band runs inline on the capture thread (no worker threads, no allocation).
+  const cv::Mat yuyv(options_.height, options_.width, CV_8UC2, base, d.bytes_per_line);
+  const int band_rows = std::max(1, (1 << 16) / options_.width);
+  for (int r0 = 0; r0 < options_.height; r0 += band_rows) {
+    const cv::Range rows(r0, std::min(options_.height, r0 + band_rows));
+    cv::Mat dst = bgr.rowRange(rows);
+    cv::cvtColor(yuyv.rowRange(rows), dst, cv::COLOR_YUV2BGR_YUYV);
+  }
+}
+
 Status V4l2StereoSource::deliver(StereoFrame& out) {
   Device& left = devices_[0];
   const bool sbs = options_.layout == V4l2Layout::kSideBySide;
@@ -329,6 +347,10 @@ Status V4l2StereoSource::deliver(StereoFrame& out) {
   out.right.create(options_.height, options_.width, CV_8UC1);
   copyEye(left, left.held, 0, out.left);
   copyEye(right, right.held, sbs ? options_.width : 0, out.right);
+  if (options_.left_color) {
+    out.left_color.create(options_.height, options_.width, CV_8UC3);
+    colorEye(left, left.held, out.left_color);
+  }
 
   out.sequence = sequence_base_ + left.held.sequence;
   next_sequence_ = out.sequence + 1;

@@ -14,6 +14,7 @@
 #include "sunvo/core/geometry.hpp"
 #include "sunvo/rover/device_sources.hpp"
 #include "sunvo/rover/fault_injection.hpp"
+#include "sunvo/rover/mavlink_link.hpp"
 #include "sunvo/runtime/clock.hpp"
 
 namespace sunvo::rover {
@@ -173,9 +174,10 @@ Expected<std::unique_ptr<RoverApp>> RoverApp::create(const RoverConfig& config,
   }
 
   runtime::FramePoolOptions frame_options = config.frames;
-  // Colour slots only where the source delivers colour (KITTI replay); the V4L2 cameras are grey
-  // and the image providers then get the grey left image (every estimator accepts it).
-  const bool colour_frames = needs_images && config.source.type != SourceType::kV4l2;
+  // Colour slots where the source delivers colour (KITTI replay; V4L2 YUYV with
+  // source.v4l2.left_color); otherwise the image providers get the grey left image.
+  const bool colour_frames =
+      needs_images && (config.source.type != SourceType::kV4l2 || config.source.v4l2.left_color);
   frame_options.color = colour_frames;  // the capture thread copies left_color for the provider
   auto pool = runtime::FramePool::create(frame_options);
   if (!pool) return pool.status();
@@ -214,7 +216,10 @@ Expected<std::unique_ptr<RoverApp>> RoverApp::create(const RoverConfig& config,
       return Status(opened.status().code(), "telemetry.pose_log: " + opened.status().message());
     pose_log = std::move(*opened);
   }
-  if (link) link->setWorldOrigin(world->origin.lat_deg, world->origin.lon_deg, world->origin.alt_m);
+  if (link) {
+    link->setWorldOrigin(world->origin.lat_deg, world->origin.lon_deg, world->origin.alt_m);
+    link->setCameraMount(bodyFromCamera(config.body, impl->source->C_c_l()));
+  }
   impl->telemetry =
       std::make_unique<TelemetryStage>(*impl->ctx, std::move(link), std::move(pose_log));
   const auto warmup = static_cast<std::uint64_t>(config.realtime.warmup_frames);
@@ -351,6 +356,11 @@ std::string RoverApp::summary() const {
   std::string o;
   const TimeNs end = s.end_mono_ns != 0 ? s.end_mono_ns : runtime::monotonicNs();
   appendf(&o, "summary (%.1f s):\n", static_cast<double>(end - s.start_mono_ns) * 1e-9);
+  const StereoCamera& cam = s.source->camera();
+  const auto* v4l2 = dynamic_cast<const V4l2FrameSource*>(s.source.get());
+  appendf(&o, "  camera %dx%d: fu %.2f fv %.2f cu %.2f cv %.2f px, baseline %.4f m (%s)\n",
+          cam.width, cam.height, cam.fu, cam.fv, cam.cu, cam.cv, cam.baseline_m,
+          v4l2 != nullptr && v4l2->rectifies() ? "rectified here" : "frames as delivered");
   appendf(&o,
           "  triggers %" PRIu64 " (timeouts %" PRIu64 ", missed %" PRIu64 ", duplicate %" PRIu64
           "), frames grabbed %" PRIu64 " (grab errors %" PRIu64 ", pool exhausted %" PRIu64 ")\n",

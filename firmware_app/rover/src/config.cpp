@@ -273,6 +273,12 @@ Status RoverConfig::validate() const {
   }
   if (source.type == SourceType::kV4l2) {
     if (source.v4l2.calibration.empty()) return invalidArgument("source.v4l2.calibration: empty");
+    if (const Status r = source.v4l2.rectify.validate(); !r.isOk()) {
+      return Status(r.code(), "source.v4l2.rectify." + r.message());
+    }
+    if (source.v4l2.left_color && source.v4l2.pixel_format != v4l2::V4l2PixelFormat::kYuyv) {
+      return invalidArgument("source.v4l2.left_color: needs source.v4l2.pixel_format yuyv");
+    }
     SUNVO_RETURN_IF_ERROR(checkRange("source.v4l2.buffer_count", source.v4l2.buffer_count, 2, 32));
     SUNVO_RETURN_IF_ERROR(
         checkRange("source.v4l2.dequeue_timeout_ms", source.v4l2.dequeue_timeout_ms, 1, 60000));
@@ -336,6 +342,12 @@ Status RoverConfig::validate() const {
   if (sun.provider == SunProviderType::kSunCnn && sun.model.empty()) {
     return invalidArgument("sun.model: empty, but sun.provider is sun_cnn");
   }
+  SUNVO_RETURN_IF_ERROR(checkRange("body.camera_yaw_deg", body.camera_yaw_deg, -180, 180));
+  SUNVO_RETURN_IF_ERROR(checkRange("body.camera_pitch_deg", body.camera_pitch_deg, -90, 90));
+  SUNVO_RETURN_IF_ERROR(checkRange("body.camera_roll_deg", body.camera_roll_deg, -180, 180));
+  SUNVO_RETURN_IF_ERROR(checkRange("body.camera_x_m", body.camera_x_m, -100, 100));
+  SUNVO_RETURN_IF_ERROR(checkRange("body.camera_y_m", body.camera_y_m, -100, 100));
+  SUNVO_RETURN_IF_ERROR(checkRange("body.camera_z_m", body.camera_z_m, -100, 100));
   SUNVO_RETURN_IF_ERROR(
       checkRange("serial.tx_buffer_bytes", serial.tx_buffer_bytes, 1024, 1048576));
   SUNVO_RETURN_IF_ERROR(checkOpenLow("telemetry.heartbeat_hz", telemetry.heartbeat_hz, 0.0, 50.0));

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "sunvo/kitti/calibration.hpp"
+#include "sunvo/rover/sun_provider.hpp"
 
 namespace sunvo::rover {
 
@@ -39,12 +40,36 @@ Expected<std::unique_ptr<V4l2FrameSource>> V4l2FrameSource::open(const RoverConf
                                                                  TimeNs utc_minus_mono_ns) {
   const V4l2SourceConfig& c = config.source.v4l2;
   if (c.calibration.empty()) return invalidArgument("source.v4l2.calibration: empty");
-  auto c2c = kitti::readCamToCam(c.calibration);
-  if (!c2c)
-    return Status(c2c.status().code(), "source.v4l2.calibration: " + c2c.status().message());
-  auto camera = kitti::rawStereoCamera(*c2c, 0, 1);
-  if (!camera) {
-    return Status(camera.status().code(), "source.v4l2.calibration: " + camera.status().message());
+  const auto format = calib::detectFormat(c.calibration, c.calibration_format);
+  if (!format) {
+    return Status(format.status().code(), "source.v4l2.calibration: " + format.status().message());
+  }
+  StereoCamera camera;
+  std::unique_ptr<calib::StereoRectifier> rectifier;
+  if (*format == calib::CalibrationFormat::kKitti) {
+    auto c2c = kitti::readCamToCam(c.calibration);
+    if (!c2c)
+      return Status(c2c.status().code(), "source.v4l2.calibration: " + c2c.status().message());
+    auto rect = kitti::rawStereoCamera(*c2c, 0, 1);
+    if (!rect) {
+      return Status(rect.status().code(), "source.v4l2.calibration: " + rect.status().message());
+    }
+    camera = *rect;
+  } else {
+    auto raw = calib::readRawStereoCalibration(c.calibration, *format);
+    if (!raw)
+      return Status(raw.status().code(), "source.v4l2.calibration: " + raw.status().message());
+    if (raw->size != cv::Size(config.frames.width, config.frames.height)) {
+      return invalidArgument(
+          "source.v4l2.calibration: " + c.calibration + ": image size " +
+          std::to_string(raw->size.width) + "x" + std::to_string(raw->size.height) +
+          " differs from frames.width/height " + std::to_string(config.frames.width) + "x" +
+          std::to_string(config.frames.height));
+    }
+    auto r = calib::StereoRectifier::create(*raw, c.rectify);
+    if (!r) return Status(r.status().code(), "source.v4l2.calibration: " + r.status().message());
+    rectifier = std::move(*r);
+    camera = rectifier->camera();
   }
 
   v4l2::V4l2Options vo;
@@ -52,6 +77,9 @@ Expected<std::unique_ptr<V4l2FrameSource>> V4l2FrameSource::open(const RoverConf
   vo.left_device = c.left_device;
   vo.right_device = c.right_device;
   vo.pixel_format = c.pixel_format;
+  // Colour only for a provider that looks at images (the frame pool has colour slots then).
+  const bool colour = c.left_color && sunProviderNeedsImages(config.sun.provider);
+  vo.left_color = colour;
   vo.width = config.frames.width;
   vo.height = config.frames.height;
   vo.fps = config.trigger.rate_hz;
@@ -68,7 +96,15 @@ Expected<std::unique_ptr<V4l2FrameSource>> V4l2FrameSource::open(const RoverConf
   if (!pairer) return Status(pairer.status().code(), "trigger: " + pairer.status().message());
 
   std::unique_ptr<V4l2FrameSource> s(new V4l2FrameSource());
-  s->camera_ = *camera;
+  s->camera_ = camera;
+  if (rectifier) {
+    // The camera's frame before rectification, allocated here so grab() allocates nothing.
+    const cv::Size size(config.frames.width, config.frames.height);
+    s->raw_.left.create(size, CV_8UC1);
+    s->raw_.right.create(size, CV_8UC1);
+    if (colour) s->raw_.left_color.create(size, CV_8UC3);
+    s->rectifier_ = std::move(rectifier);
+  }
   s->camera_source_ = std::move(*cam);
   s->pairer_ = std::make_unique<gpio::TriggerPairer>(std::move(*pairer));
   s->utc_minus_mono_ns_ = utc_minus_mono_ns;
@@ -82,10 +118,12 @@ Status V4l2FrameSource::grab(const TriggerEvent& trigger, runtime::FrameSlot& sl
   const TimeNs delay_ns = pairer_->options().expected_delay_ns;
   const TimeNs window_ns = pairer_->options().match_window_ns;
   for (int read = 0; read < max_reads_; ++read) {
-    SUNVO_RETURN_IF_ERROR(camera_source_->next(frame));  // writes into the slot's Mats
+    // Rectified frames go straight into the slot's Mats; raw ones into raw_ first.
+    SUNVO_RETURN_IF_ERROR(camera_source_->next(rectifier_ ? raw_ : frame));
     const TimeNs frame_ns = camera_source_->lastPair().left_time_ns;
     const std::optional<gpio::TriggerEvent> paired = pairer_->matchFrame(frame_ns);
     if (paired) {
+      if (rectifier_) SUNVO_RETURN_IF_ERROR(rectifier_->rectify(raw_, frame));
       frame.sequence = trigger.sequence;
       frame.trigger_time_ns = paired->time_ns + utc_minus_mono_ns_;
       slot.meta.source_index = camera_source_->lastPair().left_sequence;

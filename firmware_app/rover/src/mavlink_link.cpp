@@ -1,5 +1,6 @@
 #include "sunvo/rover/mavlink_link.hpp"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cinttypes>
 #include <cmath>
@@ -58,6 +59,31 @@ mavlink::OdometryInput odometryInput(const PoseRecord& pose, const TelemetryConf
   return in;
 }
 
+Isometry3 bodyFromCamera(const BodyConfig& body, const Eigen::Matrix3d& C_c_l) {
+  constexpr double kDeg = M_PI / 180.0;
+  const Eigen::Matrix3d turn =
+      (Eigen::AngleAxisd(body.camera_yaw_deg * kDeg, Eigen::Vector3d::UnitZ()) *
+       Eigen::AngleAxisd(body.camera_pitch_deg * kDeg, Eigen::Vector3d::UnitY()) *
+       Eigen::AngleAxisd(body.camera_roll_deg * kDeg, Eigen::Vector3d::UnitX()))
+          .toRotationMatrix();
+  const Eigen::Matrix3d C_b_l = turn * mavlink::cameraForwardC_b_c();
+  Isometry3 T_b_c = Isometry3::Identity();
+  T_b_c.linear() = C_b_l * C_c_l.transpose();
+  T_b_c.translation() = Eigen::Vector3d(body.camera_x_m, body.camera_y_m, body.camera_z_m);
+  return T_b_c;
+}
+
+void moveToBodyOrigin(const Eigen::Vector3d& t_b_c, const Eigen::Matrix3d& C_b_c,
+                      mavlink::OdometryInput* in) {
+  if (t_b_c.isZero(0.0)) return;
+  const Eigen::Vector3d t_c_b = -C_b_c.transpose() * t_b_c;
+  const Eigen::Matrix3d C_w_c = in->T_w_c.linear();
+  in->T_w_c.translation() += C_w_c * t_c_b;
+  if (in->v_w.allFinite() && in->omega_c.allFinite()) {
+    in->v_w += C_w_c * in->omega_c.cross(t_c_b);
+  }
+}
+
 mavlink::SetGpsGlobalOrigin globalOrigin(double lat_deg, double lon_deg, double alt_m) {
   mavlink::SetGpsGlobalOrigin o;
   o.latitude = static_cast<std::int32_t>(std::lround(lat_deg * 1e7));
@@ -105,8 +131,9 @@ Status MavlinkSerialLink::sendPose(const PoseRecord& pose, TimeNs now_mono_ns) {
   }
   lost_ = lost;
 
-  mavlink::Odometry odo = mavlink::toOdometry(odometryInput(pose, telemetry_, distance_m_),
-                                              mavlink::WorldConvention::kEnu, C_b_c_);
+  mavlink::OdometryInput in = odometryInput(pose, telemetry_, distance_m_);
+  moveToBodyOrigin(t_b_c_, C_b_c_, &in);
+  mavlink::Odometry odo = mavlink::toOdometry(in, mavlink::WorldConvention::kEnu, C_b_c_);
   mavlink::applyProfile(telemetry_.frame, &odo);
   const std::size_t n = mavlink::encodeOdometry(odo, endpoint_, seq_++, buffer_.data());
   Status st = port_->send(buffer_.data(), n, now_mono_ns);
@@ -132,6 +159,11 @@ void MavlinkSerialLink::setWorldOrigin(double lat_deg, double lon_deg, double al
   origin_ = globalOrigin(lat_deg, lon_deg, alt_m);
   have_origin_ = true;
   next_origin_ns_ = 0;  // at the next service()
+}
+
+void MavlinkSerialLink::setCameraMount(const Isometry3& T_b_c) {
+  C_b_c_ = T_b_c.linear();
+  t_b_c_ = T_b_c.translation();
 }
 
 void MavlinkSerialLink::setPoseStale(bool stale, TimeNs now_mono_ns) {

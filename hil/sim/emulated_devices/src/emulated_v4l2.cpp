@@ -23,10 +23,8 @@ void copyName(std::uint8_t* dst, std::size_t size, const std::string& text) {
   std::memcpy(dst, text.data(), std::min(size - 1, text.size()));
 }
 
-// The chroma the emulator writes into YUYV frames: varies with x and y so that a converter that
-// mixes chroma into the gray image is caught.
 std::uint8_t chromaAt(int x, int y) {
-  return static_cast<std::uint8_t>((x * 7 + y * 3) & 0xff);
+  return yuyvChroma(x, y);
 }
 
 // A FIFO of buffer indices with room for every buffer: the emulated kernel's queues allocate
@@ -581,6 +579,12 @@ sysio::SysResult EmulatedV4l2::poll(pollfd* fds, nfds_t nfds, int timeout_ms) {
       return {scan(), 0};
     }
   }
+}
+
+// The chroma the emulator writes into YUYV frames: varies with x and y so that a converter that
+// mixes chroma into the gray image is caught.
+std::uint8_t yuyvChroma(int x, int y) {
+  return static_cast<std::uint8_t>((x * 7 + y * 3) & 0xff);
 }
 
 }  // namespace sunvo::emulated

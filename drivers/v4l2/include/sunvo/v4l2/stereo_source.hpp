@@ -3,8 +3,9 @@
 //
 // Two layouts: two devices (left and right cameras, each width x height) or one side-by-side
 // device (2*width x height, the left eye in the left half). Pixel formats GREY (8-bit) and YUYV
-// (4:2:2; the luma bytes are the gray image). The kernel is reached only through a
-// sysio::SysIo&, so tests run this code unchanged against hil/sim/emulated_devices.
+// (4:2:2; the luma bytes are the gray image; optionally the left eye in colour too). The kernel is
+// reached only through a sysio::SysIo&, so tests run this code unchanged against
+// hil/sim/emulated_devices.
 //
 // Life of a device: open(O_RDWR|O_NONBLOCK) → VIDIOC_QUERYCAP → S_FMT → S_PARM (frame rate)
 // → REQBUFS (MMAP) → QUERYBUF + mmap once per buffer → QBUF all → STREAMON; per frame poll (with
@@ -67,6 +68,9 @@ struct V4l2Options {
   int reopen_backoff_initial_ms = 100;  // first wait before reopening a lost device, [1, 60000]
   int reopen_backoff_max_ms = 5000;     // the wait doubles up to this, [initial, 600000]
   TimeNs max_pair_skew_ns = 2'000'000;  // largest left/right timestamp difference, [0, 1e9] ns
+  // YUYV only: also convert the left eye to colour (BGR, CV_8UC3) into StereoFrame::left_color
+  // with cv::cvtColor(COLOR_YUV2BGR_YUYV), for the colour image sun estimators. Off: grey only.
+  bool left_color = false;
 
   // Names the first bad key, e.g. "v4l2.width: 7 is outside [16, 8192]".
   Status validate() const;
@@ -160,6 +164,7 @@ class V4l2StereoSource {
   Status waitForReopen(TimeNs deadline);
   Status deliver(StereoFrame& out);
   void copyEye(const Device& d, const Held& held, int x0, cv::Mat& eye) const;
+  void colorEye(const Device& d, const Held& held, cv::Mat& bgr) const;  // the left eye, YUYV
 
   V4l2Options options_;
   sysio::SysIo& io_;

@@ -17,6 +17,8 @@
 #include <utility>
 #include <vector>
 
+#include "sunvo/calib/rectifier.hpp"
+#include "sunvo/calib/stereo_calibration.hpp"
 #include "sunvo/core/fields.hpp"
 #include "sunvo/core/status.hpp"
 #include "sunvo/mavlink/conventions.hpp"
@@ -94,9 +96,21 @@ struct KittiSourceConfig {
 struct V4l2SourceConfig {
   std::string left_device = "/dev/video0";   // V4L2 node of the left camera
   std::string right_device = "/dev/video1";  // V4L2 node of the right camera
-  std::string calibration = "";              // KITTI-style calib_cam_to_cam.txt of the rig
+  // The rig's calibration (docs/deployment.md, "Stereo calibration"): a KITTI
+  // calib_cam_to_cam.txt (cameras that deliver rectified images: P_rect_00/01, no remap), or a
+  // raw calibration, OpenCV stereo YAML or Kalibr camchain.yaml, from which every frame is
+  // rectified (calib::StereoRectifier) before the estimator; its image size must be
+  // frames.width x frames.height.
+  std::string calibration = "";
+  calib::CalibrationFormat calibration_format = calib::CalibrationFormat::kAuto;
+  // ^ auto | kitti | opencv | kalibr (auto: by the file's content)
+  calib::RectifyOptions rectify;  // raw calibrations: rectify.alpha, [0, 1]
   v4l2::V4l2Layout layout = v4l2::V4l2Layout::kTwoDevices;            // two_devices | side_by_side
   v4l2::V4l2PixelFormat pixel_format = v4l2::V4l2PixelFormat::kGrey;  // grey | yuyv
+  // yuyv only: also the left image in colour (BGR) for the image sun providers (the colour
+  // Sun-CNN model needs it; converted only when sun.provider looks at images); off: the
+  // providers get the grey image.
+  bool left_color = false;
   int buffer_count = 4;          // MMAP buffers per device, [2, 32]
   int dequeue_timeout_ms = 200;  // ms, [1, 60000]: the longest wait for one stereo pair
   template <class Self, class V>
@@ -104,8 +118,11 @@ struct V4l2SourceConfig {
     v("left_device", s.left_device);
     v("right_device", s.right_device);
     v("calibration", s.calibration);
+    v("calibration_format", s.calibration_format);
+    v("rectify", s.rectify);
     v("layout", s.layout);
     v("pixel_format", s.pixel_format);
+    v("left_color", s.left_color);
     v("buffer_count", s.buffer_count);
     v("dequeue_timeout_ms", s.dequeue_timeout_ms);
   }
@@ -297,6 +314,31 @@ struct TelemetryConfig {
   }
 };
 
+// Where the camera sits on the vehicle: T_b_c, the raw left camera c in the body frame b that
+// the telemetry reports (MAV_FRAME_BODY_FRD: x forward, y right, z down; its origin is the point
+// the autopilot tracks). The attitude is relative to a camera looking forward with its image
+// upright (c.z = b.x, c.x = b.y, c.y = b.z), turned by yaw, then pitch, then roll about the body
+// axes: C_b_c = Rz(yaw) Ry(pitch) Rx(roll) C_b_c(forward). With a raw calibration the estimator's
+// camera is the rectified left camera, turned by the rectification (its centre is the same).
+struct BodyConfig {
+  double camera_yaw_deg = 0.0;    // deg, [-180, 180]: + turns the optical axis to the right
+  double camera_pitch_deg = 0.0;  // deg, [-90, 90]: + tilts the optical axis up
+  double camera_roll_deg = 0.0;   // deg, [-180, 180]: + lowers the image's right side
+  // Lever arm: the left camera's optical centre in b (t_b_c), m, each in [-100, 100].
+  double camera_x_m = 0.0;  // m, forward of the body origin
+  double camera_y_m = 0.0;  // m, right of it
+  double camera_z_m = 0.0;  // m, below it
+  template <class Self, class V>
+  static void fields(Self& s, V& v) {
+    v("camera_yaw_deg", s.camera_yaw_deg);
+    v("camera_pitch_deg", s.camera_pitch_deg);
+    v("camera_roll_deg", s.camera_roll_deg);
+    v("camera_x_m", s.camera_x_m);
+    v("camera_y_m", s.camera_y_m);
+    v("camera_z_m", s.camera_z_m);
+  }
+};
+
 // Field health (health_watch.hpp): when to give up so that systemd's Restart=on-failure fires.
 struct HealthConfig {
   // s, [0, 3600]: a fault (the camera delivers no frame, the estimator is lost on every frame,
@@ -370,6 +412,7 @@ struct RoverConfig {
   SunConfig sun;
   SerialConfig serial;
   TelemetryConfig telemetry;
+  BodyConfig body;
   HealthConfig health;
   RtConfig rt;
   ProfilingConfig profiling;
@@ -390,6 +433,7 @@ struct RoverConfig {
     v("sun", s.sun);
     v("serial", s.serial);
     v("telemetry", s.telemetry);
+    v("body", s.body);
     v("health", s.health);
     v("rt", s.rt);
     v("profiling", s.profiling);

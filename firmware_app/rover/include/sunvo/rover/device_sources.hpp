@@ -11,6 +11,7 @@
 
 #include <memory>
 
+#include "sunvo/calib/rectifier.hpp"
 #include "sunvo/gpio/gpio_api.hpp"
 #include "sunvo/gpio/trigger.hpp"
 #include "sunvo/gpio/trigger_pairer.hpp"
@@ -41,11 +42,17 @@ class StrobeTrigger final : public TriggerSource {
 class V4l2FrameSource final : public FrameSource {
  public:
   // The options come from source.v4l2 and frames.width/height; the camera model from
-  // source.v4l2.calibration (KITTI calib_cam_to_cam.txt, rectified cameras 00/01).
+  // source.v4l2.calibration: a KITTI calib_cam_to_cam.txt (rectified cameras 00/01, frames used
+  // as they come), or a raw OpenCV / Kalibr calibration, from which a calib::StereoRectifier is
+  // built once and every paired frame is rectified into the slot (no allocation once warm).
   static Expected<std::unique_ptr<V4l2FrameSource>> open(const RoverConfig& config,
                                                          sysio::SysIo& io,
                                                          TimeNs utc_minus_mono_ns);
   const StereoCamera& camera() const override { return camera_; }
+  Eigen::Matrix3d C_c_l() const override {
+    return rectifier_ ? rectifier_->C_c_l() : Eigen::Matrix3d::Identity();
+  }
+  bool rectifies() const { return rectifier_ != nullptr; }
   // Hands the trigger to the pairer, then reads frames until one pairs with a trigger: a frame
   // whose strobe was lost (older than every held trigger) is skipped, at most buffer_count + 1
   // frames per call. frame.trigger_time_ns = the paired strobe's time in UTC;
@@ -60,6 +67,8 @@ class V4l2FrameSource final : public FrameSource {
   StereoCamera camera_;
   std::unique_ptr<v4l2::V4l2StereoSource> camera_source_;
   std::unique_ptr<gpio::TriggerPairer> pairer_;
+  std::unique_ptr<calib::StereoRectifier> rectifier_;  // null: the frames come rectified
+  StereoFrame raw_;  // the camera's frame before rectification (allocated at open())
   TimeNs utc_minus_mono_ns_ = 0;
   int max_reads_ = 5;
 };

@@ -2,7 +2,8 @@
 // PoseLink over a serial port with MAVLink v2 (drivers/mavlink for the framing and the frame
 // conventions, drivers/serial for the non-blocking port). Sends:
 //   ODOMETRY (#331) per pose. The world is ENU at the first GPS fix, sent as NED numbers; the
-//     body is the camera looking forward (MAV_FRAME_BODY_FRD). frame_id by telemetry.frame:
+//     body (MAV_FRAME_BODY_FRD) is body.* (T_b_c: a forward-looking camera by default, lever arm
+//     applied to position and velocity). frame_id by telemetry.frame:
 //     px4 -> MAV_FRAME_LOCAL_NED, ardupilot -> MAV_FRAME_LOCAL_FRD. Covariance: attitude from the
 //     sun filter (world frame, rotated into the sent frame by toOdometry) or the configured sigma
 //     without the sun; position sigma = position_sigma_m + position_sigma_per_m * path length
@@ -33,6 +34,17 @@ namespace sunvo::rover {
 mavlink::OdometryInput odometryInput(const PoseRecord& pose, const TelemetryConfig& telemetry,
                                      double distance_m);
 
+// T_b_c of body.*: the rotation of the configured mount times C_c_l^T (the images' camera c from
+// the physical left camera l, e.g. the rectification), the lever arm (camera_x_m, _y_m, _z_m).
+Isometry3 bodyFromCamera(const BodyConfig& body, const Eigen::Matrix3d& C_c_l);
+
+// Moves an ODOMETRY input from the camera's origin to the body's: with t_c_b = -C_b_c^T t_b_c
+// (the body origin in c), p_w_b = p_w_c + C_w_c t_c_b and, for a rigid body,
+// v_w_b = v_w_c + C_w_c (omega_c x t_c_b). The attitude stays C_w_c (toOdometry applies C_b_c);
+// the covariance is kept (the lever arm's share of it is second order for small attitude errors).
+void moveToBodyOrigin(const Eigen::Vector3d& t_b_c, const Eigen::Matrix3d& C_b_c,
+                      mavlink::OdometryInput* in);
+
 // The SET_GPS_GLOBAL_ORIGIN of a world origin (deg, deg, m above MSL); time_usec 0 (unknown).
 mavlink::SetGpsGlobalOrigin globalOrigin(double lat_deg, double lon_deg, double alt_m);
 
@@ -47,6 +59,7 @@ class MavlinkSerialLink final : public PoseLink {
   TimeNs lastByteWrittenNs() const override { return port_->lastByteWrittenNs(); }
   void setPoseStale(bool stale, TimeNs now_mono_ns) override;
   void setWorldOrigin(double lat_deg, double lon_deg, double alt_m) override;
+  void setCameraMount(const Isometry3& T_b_c) override;
   std::string countersText() const override;
   double distanceM() const { return distance_m_; }
 
@@ -60,7 +73,8 @@ class MavlinkSerialLink final : public PoseLink {
   std::unique_ptr<serial::SerialPort> port_;
   TelemetryConfig telemetry_;
   mavlink::Endpoint endpoint_;
-  Eigen::Matrix3d C_b_c_;
+  Eigen::Matrix3d C_b_c_;                            // camera -> body rotation (setCameraMount)
+  Eigen::Vector3d t_b_c_ = Eigen::Vector3d::Zero();  // m, the camera's origin in the body
   mavlink::SetGpsGlobalOrigin origin_;
   bool have_origin_ = false;
   std::uint8_t seq_ = 0;

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <string>
 
+#include "sunvo/core/geometry.hpp"
 #include "sunvo/core/status.hpp"
 #include "sunvo/core/time.hpp"
 
@@ -55,6 +56,10 @@ class PoseLink {
     (void)lon_deg;
     (void)alt_m;
   }
+  // Where the estimator's camera c sits in the body frame b the stream reports (T_b_c: rotation
+  // C_b_c, lever arm t_b_c = c's origin in b, m), set once before the stream starts; a MAVLink
+  // link sends the body's pose; default: ignored.
+  virtual void setCameraMount(const Isometry3& T_b_c) { (void)T_b_c; }
   // One line of counters for the summary.
   virtual std::string countersText() const = 0;
 };

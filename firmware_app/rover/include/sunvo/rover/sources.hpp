@@ -8,6 +8,7 @@
 // gives the recording's frame for each trigger; both follow one ReplaySchedule, which also loops
 // or ping-pongs the recording for long runs.
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -41,6 +42,9 @@ class FrameSource {
  public:
   virtual ~FrameSource() = default;
   virtual const StereoCamera& camera() const = 0;
+  // C_c_l: the images' camera frame c from the physical left camera l (p_c = C_c_l p_l); the
+  // rectification's rotation for a source that rectifies, else the identity.
+  virtual Eigen::Matrix3d C_c_l() const { return Eigen::Matrix3d::Identity(); }
   // Writes the frame exposed at `trigger` into slot.frame (its Mats have the configured size)
   // and sets slot.meta.source_index. No allocation once warm.
   virtual Status grab(const TriggerEvent& trigger, runtime::FrameSlot& slot) = 0;

@@ -49,6 +49,8 @@ using FrameContent = std::function<void(std::uint64_t frame, cv::Mat& gray)>;
 FrameContent imageSequence(std::vector<cv::Mat> images);
 // The default content: a deterministic pattern of (x, y, frame, seed).
 FrameContent patternContent(int seed);
+// The chroma of YUYV frames: U of the pixel pair starting at (x, y) (x even); V = 255 - U.
+std::uint8_t yuyvChroma(int x, int y);
 
 struct EmulatedCameraConfig {
   std::string path = "/dev/video0";
