@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
 namespace sunvo::rover {
@@ -120,6 +121,34 @@ TEST(FaultyTrigger, ASwallowedEdgeIsAMissedTriggerForTheMonitor) {
   EXPECT_EQ(monitor.missed(), counts.missed_triggers.load());
   EXPECT_EQ(last + 1, 5000 + counts.missed_triggers.load());
   EXPECT_NEAR(static_cast<double>(counts.missed_triggers.load()), 5000.0 / 0.9 * 0.1, 5 * 22.0);
+}
+
+// A source that rectifies, with a rectification rotation.
+class RectifyingSource final : public FrameSource {
+ public:
+  const StereoCamera& camera() const override { return camera_; }
+  Eigen::Matrix3d C_c_l() const override {
+    return Eigen::AngleAxisd(0.01, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  }
+  bool rectifies() const override { return true; }
+  Status grab(const TriggerEvent&, runtime::FrameSlot&) override { return Status::ok(); }
+
+ private:
+  StereoCamera camera_;
+};
+
+// The decorator is transparent for what the rover reads from the source besides frames (the
+// camera-to-body mount uses C_c_l, the summary rectifies()).
+TEST(FaultyFrameSource, ForwardsTheRectificationOfTheSourceItWraps) {
+  FaultInjectionConfig config;
+  config.bad_frame_rate = 0.1;
+  InjectedFaults counts;
+  auto inner = std::make_unique<RectifyingSource>();
+  const Eigen::Matrix3d expected = inner->C_c_l();
+  const FaultyFrameSource source(std::move(inner), config, counts);
+  EXPECT_TRUE(source.rectifies());
+  EXPECT_TRUE(source.C_c_l().isApprox(expected, 1e-15));
+  EXPECT_FALSE(source.C_c_l().isIdentity(1e-6));
 }
 
 TEST(FaultInjectionConfig, OffByDefaultAndRangesNameTheKey) {

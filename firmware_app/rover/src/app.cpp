@@ -357,10 +357,9 @@ std::string RoverApp::summary() const {
   const TimeNs end = s.end_mono_ns != 0 ? s.end_mono_ns : runtime::monotonicNs();
   appendf(&o, "summary (%.1f s):\n", static_cast<double>(end - s.start_mono_ns) * 1e-9);
   const StereoCamera& cam = s.source->camera();
-  const auto* v4l2 = dynamic_cast<const V4l2FrameSource*>(s.source.get());
   appendf(&o, "  camera %dx%d: fu %.2f fv %.2f cu %.2f cv %.2f px, baseline %.4f m (%s)\n",
           cam.width, cam.height, cam.fu, cam.fv, cam.cu, cam.cv, cam.baseline_m,
-          v4l2 != nullptr && v4l2->rectifies() ? "rectified here" : "frames as delivered");
+          s.source->rectifies() ? "rectified here" : "frames as delivered");
   appendf(&o,
           "  triggers %" PRIu64 " (timeouts %" PRIu64 ", missed %" PRIu64 ", duplicate %" PRIu64
           "), frames grabbed %" PRIu64 " (grab errors %" PRIu64 ", pool exhausted %" PRIu64 ")\n",

@@ -52,7 +52,7 @@ class V4l2FrameSource final : public FrameSource {
   Eigen::Matrix3d C_c_l() const override {
     return rectifier_ ? rectifier_->C_c_l() : Eigen::Matrix3d::Identity();
   }
-  bool rectifies() const { return rectifier_ != nullptr; }
+  bool rectifies() const override { return rectifier_ != nullptr; }
   // Hands the trigger to the pairer, then reads frames until one pairs with a trigger: a frame
   // whose strobe was lost (older than every held trigger) is skipped, at most buffer_count + 1
   // frames per call. frame.trigger_time_ns = the paired strobe's time in UTC;

@@ -46,6 +46,8 @@ class FaultyFrameSource final : public FrameSource {
   FaultyFrameSource(std::unique_ptr<FrameSource> inner, const FaultInjectionConfig& config,
                     InjectedFaults& counts);
   const StereoCamera& camera() const override { return inner_->camera(); }
+  Eigen::Matrix3d C_c_l() const override { return inner_->C_c_l(); }
+  bool rectifies() const override { return inner_->rectifies(); }
   Status grab(const TriggerEvent& trigger, runtime::FrameSlot& slot) override;
 
  private:

@@ -45,6 +45,8 @@ class FrameSource {
   // C_c_l: the images' camera frame c from the physical left camera l (p_c = C_c_l p_l); the
   // rectification's rotation for a source that rectifies, else the identity.
   virtual Eigen::Matrix3d C_c_l() const { return Eigen::Matrix3d::Identity(); }
+  // True when the source rectifies the frames itself (a raw calibration), for the summary.
+  virtual bool rectifies() const { return false; }
   // Writes the frame exposed at `trigger` into slot.frame (its Mats have the configured size)
   // and sets slot.meta.source_index. No allocation once warm.
   virtual Status grab(const TriggerEvent& trigger, runtime::FrameSlot& slot) = 0;
