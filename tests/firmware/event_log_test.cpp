@@ -8,20 +8,14 @@
 
 #include <string>
 
+#include "../support/drain_fd.hpp"
+
 #if defined(SUNVO_HAVE_ALLOC_COUNTER)
 #include "sunvo/runtime/alloc_counter.hpp"
 #endif
 
 namespace sunvo::runtime {
 namespace {
-
-std::string drain(int fd) {
-  std::string out;
-  char buf[4096];
-  ssize_t n;
-  while ((n = read(fd, buf, sizeof(buf))) > 0) out.append(buf, static_cast<std::size_t>(n));
-  return out;
-}
 
 TEST(EventLog, PriorityPrefixesAndOneLinePerEvent) {
   int p[2];
@@ -31,7 +25,7 @@ TEST(EventLog, PriorityPrefixesAndOneLinePerEvent) {
   log.log(LogPriority::kWarning, "fault: camera %s\nsilent", "/dev/sunvo-left");
   log.log(LogPriority::kErr, "exit %d", 3);
   close(p[1]);
-  EXPECT_EQ(drain(p[0]),
+  EXPECT_EQ(testing::drainFd(p[0]),
             "<6>sunvo_rover: ready (4 threads)\n"
             "<4>sunvo_rover: fault: camera /dev/sunvo-left silent\n"
             "<3>sunvo_rover: exit 3\n");
@@ -46,7 +40,7 @@ TEST(EventLog, LongLineIsCutAndEndsWithNewline) {
   const std::string text(2000, 'y');
   log.log(LogPriority::kInfo, "%s", text.c_str());
   close(p[1]);
-  const std::string line = drain(p[0]);
+  const std::string line = testing::drainFd(p[0]);
   close(p[0]);
   EXPECT_EQ(line.size(), EventLog::kMaxLine);
   EXPECT_EQ(line.substr(0, 5), "<6>t:");
@@ -72,7 +66,8 @@ TEST(EventLog, LoggingAllocatesNothing) {
   }
   EXPECT_EQ(threadAllocationCount() - before, 0u);
   close(p[1]);
-  EXPECT_NE(drain(p[0]).find("<4>sunvo_rover: fault: camera /dev/sunvo-left"), std::string::npos);
+  EXPECT_NE(testing::drainFd(p[0]).find("<4>sunvo_rover: fault: camera /dev/sunvo-left"),
+            std::string::npos);
   close(p[0]);
 #else
   GTEST_SKIP() << "allocation counter not linked (sanitizer build)";

@@ -17,6 +17,7 @@
 #include <thread>
 #include <vector>
 
+#include "../support/emulated_rig.hpp"
 #include "../support/recording_link.hpp"
 #include "sunvo/emulated/emulated_gpio.hpp"
 #include "sunvo/emulated/emulated_v4l2.hpp"
@@ -28,21 +29,11 @@
 namespace sunvo::rover {
 namespace {
 
-constexpr int kWidth = 1242;  // the size of the calibration used (kitti_raw_sample)
-constexpr int kHeight = 375;
 constexpr TimeNs kExposureDelay = 3'000'000;  // strobe edge -> V4L2 buffer timestamp, ns
-constexpr double kRateHz = 20.0;
-constexpr int kStrobeLine = 17;
+constexpr double kRateHz = testing::kRigRateHz;
+constexpr int kStrobeLine = testing::kRigStrobeLine;
 
 using sunvo::testing::RecordingLink;
-
-// A textured plane 12 px of disparity away, sliding 2 px per frame: trackable stereo images.
-emulated::FrameContent planeContent(const cv::Mat& texture, int disparity) {
-  return [texture, disparity](std::uint64_t frame, cv::Mat& gray) {
-    const int shift = static_cast<int>(frame % 100) * 2 + disparity;
-    texture(cv::Rect(shift, 0, gray.cols, gray.rows)).copyTo(gray);
-  };
-}
 
 struct RunResult {
   std::vector<TimeNs> strobe_edges;  // the edges that reached the line (dropped one left out)
@@ -57,43 +48,16 @@ RunResult runRig(int exposures, int drop_at, const std::string& sun_provider = "
   emulated::EmulatedGpio gpio;
   emulated::EmulatedV4l2 cameras;
   EXPECT_TRUE(gpio.addChip("gpiochip0", 32).isOk());
-  cv::Mat texture(kHeight, kWidth + 260, CV_8UC1);
-  cv::RNG rng(7);
-  rng.fill(texture, cv::RNG::UNIFORM, 0, 256);
-  // Blobs rather than pixel noise (corners for the front end), stretched to the full range.
-  cv::GaussianBlur(texture, texture, cv::Size(0, 0), 2.0);
-  cv::normalize(texture, texture, 0, 255, cv::NORM_MINMAX);
-  // The cameras under the names config/rover.yaml gives them (the package's udev links).
-  EXPECT_TRUE(cameras
-                  .addCamera({"/dev/sunvo-left", kWidth, kHeight, true, true, 0, 0,
-                              planeContent(texture, 12)})
-                  .isOk());
-  EXPECT_TRUE(cameras
-                  .addCamera({"/dev/sunvo-right", kWidth, kHeight, true, true, 0, 0,
-                              planeContent(texture, 0)})
-                  .isOk());
+  EXPECT_TRUE(testing::addRigCameras(cameras).isOk());
 
   const std::string out = std::string(SUNVO_BINARY_DIR) + "/test_out/rover_devices";
-  auto config = loadRoverConfig(
-      std::string(SUNVO_SOURCE_DIR) + "/config/rover.yaml",
-      {{"source.v4l2.calibration",
-        std::string(SUNVO_DATA_DIR) + "/kitti_raw_sample/2011_09_26/calib_cam_to_cam.txt"},
-       {"trigger.rate_hz", std::to_string(kRateHz)},
-       {"trigger.gpio_line", std::to_string(kStrobeLine)},
-       {"trigger.frame_delay_ms", "3.0"},
-       {"trigger.match_window_ms", "4.0"},
-       {"serial.device", "\"\""},
-       {"rt.lock_memory", "false"},
-       {"rt.heap_reserve_mb", "0"},
-       {"rt.threads",
-        "{capture: {fifo_priority: 0, cpu: -1}, estimator: {fifo_priority: 0, "
-        "cpu: -1}, sun: {fifo_priority: 0, cpu: -1}, telemetry: {fifo_priority: "
-        "0, cpu: -1}}"},
-       {"realtime.warmup_frames", "0"},
-       {"sun.provider", sun_provider},
+  auto overrides = testing::rigOverrides(out);
+  overrides.insert(
+      overrides.end(),
+      {{"sun.provider", sun_provider},
        {"sun.model", sun_model.empty() ? "/usr/share/sunvo/sun_cnn_gray.onnx" : sun_model},
-       {"telemetry.pose_log", pose_log.empty() ? "\"\"" : pose_log},
-       {"profiling.output_dir", out}});
+       {"telemetry.pose_log", pose_log.empty() ? "\"\"" : pose_log}});
+  auto config = loadRoverConfig(std::string(SUNVO_SOURCE_DIR) + "/config/rover.yaml", overrides);
   EXPECT_TRUE(config.hasValue()) << config.status().toString();
   if (!config) return result;
   auto link = std::make_unique<RecordingLink>();

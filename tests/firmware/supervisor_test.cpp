@@ -22,6 +22,8 @@
 #include <thread>
 #include <vector>
 
+#include "../support/drain_fd.hpp"
+#include "../support/emulated_rig.hpp"
 #include "sunvo/emulated/emulated_gpio.hpp"
 #include "sunvo/emulated/emulated_v4l2.hpp"
 #include "sunvo/rover/app.hpp"
@@ -31,17 +33,8 @@
 namespace sunvo::rover {
 namespace {
 
-constexpr int kWidth = 1242;  // the size of the calibration used (kitti_raw_sample)
-constexpr int kHeight = 375;
-constexpr double kRateHz = 20.0;
-constexpr int kStrobeLine = 17;
-
-emulated::FrameContent planeContent(const cv::Mat& texture, int disparity) {
-  return [texture, disparity](std::uint64_t frame, cv::Mat& gray) {
-    const int shift = static_cast<int>(frame % 100) * 2 + disparity;
-    texture(cv::Rect(shift, 0, gray.cols, gray.rows)).copyTo(gray);
-  };
-}
+constexpr double kRateHz = testing::kRigRateHz;
+constexpr int kStrobeLine = testing::kRigStrobeLine;
 
 // Appends every datagram waiting on a bound socket (read as systemd does, all along: the kernel
 // queues only net.unix.max_dgram_qlen datagrams, 10 by default).
@@ -54,54 +47,17 @@ void receiveAll(int fd, std::vector<std::string>* out_datagrams) {
   }
 }
 
-std::string drain(int fd) {
-  std::string out;
-  char buf[4096];
-  ssize_t n;
-  while ((n = read(fd, buf, sizeof(buf))) > 0) out.append(buf, static_cast<std::size_t>(n));
-  return out;
-}
-
 TEST(Supervisor, UnpluggedCameraStopsTheWatchdogAndEndsWithAnErrorNamingIt) {
   emulated::EmulatedGpio gpio;
   emulated::EmulatedV4l2 cameras;
   ASSERT_TRUE(gpio.addChip("gpiochip0", 32).isOk());
-  cv::Mat texture(kHeight, kWidth + 260, CV_8UC1);
-  cv::RNG rng(7);
-  rng.fill(texture, cv::RNG::UNIFORM, 0, 256);
-  cv::GaussianBlur(texture, texture, cv::Size(0, 0), 2.0);
-  cv::normalize(texture, texture, 0, 255, cv::NORM_MINMAX);
-  ASSERT_TRUE(cameras
-                  .addCamera({"/dev/sunvo-left", kWidth, kHeight, true, true, 0, 0,
-                              planeContent(texture, 12)})
-                  .isOk());
-  ASSERT_TRUE(cameras
-                  .addCamera({"/dev/sunvo-right", kWidth, kHeight, true, true, 0, 0,
-                              planeContent(texture, 0)})
-                  .isOk());
+  ASSERT_TRUE(testing::addRigCameras(cameras).isOk());
   const std::string out = std::string(SUNVO_BINARY_DIR) + "/test_out/supervisor";
   std::filesystem::create_directories(out);
-  auto config = loadRoverConfig(
-      std::string(SUNVO_SOURCE_DIR) + "/config/rover.yaml",
-      {{"source.v4l2.calibration",
-        std::string(SUNVO_DATA_DIR) + "/kitti_raw_sample/2011_09_26/calib_cam_to_cam.txt"},
-       {"trigger.rate_hz", std::to_string(kRateHz)},
-       {"trigger.gpio_line", std::to_string(kStrobeLine)},
-       {"trigger.frame_delay_ms", "3.0"},
-       {"trigger.match_window_ms", "4.0"},
-       {"serial.device", "\"\""},
-       {"rt.lock_memory", "false"},
-       {"rt.heap_reserve_mb", "0"},
-       {"rt.threads",
-        "{capture: {fifo_priority: 0, cpu: -1}, estimator: {fifo_priority: 0, "
-        "cpu: -1}, sun: {fifo_priority: 0, cpu: -1}, telemetry: {fifo_priority: "
-        "0, cpu: -1}}"},
-       {"realtime.warmup_frames", "0"},
-       {"sun.provider", "none"},
-       {"telemetry.pose_log", "\"\""},
-       {"health.fault_exit_s", "2.5"},
-       {"health.watchdog_pose_age_s", "1.0"},
-       {"profiling.output_dir", out}});
+  auto overrides = testing::rigOverrides(out);
+  overrides.insert(overrides.end(),
+                   {{"health.fault_exit_s", "2.5"}, {"health.watchdog_pose_age_s", "1.0"}});
+  auto config = loadRoverConfig(std::string(SUNVO_SOURCE_DIR) + "/config/rover.yaml", overrides);
   ASSERT_TRUE(config.hasValue()) << config.status().toString();
 
   // systemd's side: the notify socket and a 200 ms watchdog (pings every 100 ms).
@@ -199,7 +155,7 @@ TEST(Supervisor, UnpluggedCameraStopsTheWatchdogAndEndsWithAnErrorNamingIt) {
   EXPECT_EQ(notifier.errors(), 0u);
 
   close(log_pipe[1]);
-  const std::string lines = drain(log_pipe[0]);
+  const std::string lines = testing::drainFd(log_pipe[0]);
   close(log_pipe[0]);
   std::printf("%s", lines.c_str());
   EXPECT_NE(lines.find("<6>sunvo_rover: ready"), std::string::npos) << lines;
