@@ -89,7 +89,7 @@ set(SUNVO_DEB_DEPENDS
     "libstdc++6 (>= 12.2.0)")
 
 # Libraries only some programs link (sunvo_rover: the YAML config; the GPIO driver once it is
-# linked; OpenCV's dnn module through the Sun-CNN estimator): their package is added when a packaged program links them, found by walking the
+# linked; OpenCV's dnn module through the Sun-CNN estimator, calib3d through the rectifier): their package is added when a packaged program links them, found by walking the
 # programs' link libraries (static sunvo libraries pass theirs on as $<LINK_ONLY:...>).
 function(_sunvo_link_closure target out_var)
   set(seen ${${out_var}})
@@ -128,6 +128,9 @@ if("yaml-cpp" IN_LIST _sunvo_linked)
 endif()
 if("opencv_dnn" IN_LIST _sunvo_linked)
   list(APPEND SUNVO_DEB_DEPENDS "libopencv-dnn406 (>= 4.6.0)")
+endif()
+if("opencv_calib3d" IN_LIST _sunvo_linked)
+  list(APPEND SUNVO_DEB_DEPENDS "libopencv-calib3d406 (>= 4.6.0)")
 endif()
 if(SUNVO_GPIOD_LIBRARY AND "${SUNVO_GPIOD_LIBRARY}" IN_LIST _sunvo_linked)
   list(APPEND SUNVO_DEB_DEPENDS "libgpiod2 (>= 1.6.3)")
