@@ -9,6 +9,10 @@
 
 #include "../support/temp_dir.hpp"
 
+#ifdef SUNVO_HAVE_ALLOC_COUNTER
+#include "sunvo/runtime/alloc_counter.hpp"
+#endif
+
 namespace sunvo::calib {
 namespace {
 
@@ -205,6 +209,14 @@ TEST(CalibrationReaders, GarbageIsAnErrorNotAnException) {
       "cam0:\n  intrinsics: [a, b, c, d]\n",
       "{\"K1\": [1, 2, 3, 4, 5, 6, 7, 8, 9], \"D1\": \"x\"}",
       "%YAML:1.0\nK1: !!opencv-matrix\n  rows: 100000\n  cols: 100000\n  dt: d\n  data: [1]\n",
+      // Found by fuzzing: FileStorage threw std::length_error out of the reader on this one,
+      "%YAML:1.0\n---\nK0: !!opencv-matrix\n   rows: 3\n   cols: 3\n   :d td\n   data: [ ]\n"
+      "K1: [ 0.02, -0.0003, 0.0002, 0.0]\nR: [1, 0, 0, 0, 11]\nimage_width: 64\n"
+      "image_height: 48\n",
+      // and its YAML parser never returned on bytes like these (not text: refused before it).
+      "%YA\xb4\xff\xff\xff.0\n---\xff\xff\xff%YAML\xff\xff:1.0\n\xff\xff---\nK1: !!opencv-matrix\n"
+      "   rows:\xff 3\n   cols: 3\n   dt: d\n   data: [ 500., 0., 322., 0., 501., 238., 0., 0., 1. "
+      "]\n",
   };
   int k = 0;
   for (const std::string& text : inputs) {
@@ -217,6 +229,25 @@ TEST(CalibrationReaders, GarbageIsAnErrorNotAnException) {
     EXPECT_NE(a.status().message().find("garbage_"), std::string::npos) << a.status().message();
     EXPECT_NE(b.status().message().find("garbage_"), std::string::npos) << b.status().message();
   }
+}
+
+// Found by fuzzing (fuzz_stereo_calibration, CI short run): in this file K1's header is damaged
+// ("rows:distortio 3"), and OpenCV sized the matrix from it and asked for 48 GB (an
+// out-of-memory abort under ASan). The reader now checks rows, cols and data before OpenCV reads
+// the matrix. Without the allocation counter (sanitizer builds) the abort itself is the failure.
+TEST(OpenCvStereo, ADamagedMatrixHeaderIsRefusedBeforeOpenCvSizesTheMatrix) {
+  const std::string path =
+      std::string(SUNVO_SOURCE_DIR) + "/tests/calib/data/fuzz_crash_matrix_header.yaml";
+#ifdef SUNVO_HAVE_ALLOC_COUNTER
+  const std::uint64_t before = runtime::allocatedBytes();
+#endif
+  const auto c = readOpenCvStereo(path);
+  ASSERT_FALSE(c.hasValue());
+  EXPECT_NE(c.status().message().find("fuzz_crash_matrix_header.yaml"), std::string::npos)
+      << c.status().message();
+#ifdef SUNVO_HAVE_ALLOC_COUNTER
+  EXPECT_LT(runtime::allocatedBytes() - before, std::uint64_t{1} << 24);  // < 16 MiB
+#endif
 }
 
 TEST(CalibrationFormat, DetectedByContent) {

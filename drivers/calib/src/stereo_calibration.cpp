@@ -47,10 +47,47 @@ cv::Matx33d toMatx33(const std::vector<double>& v) {
 
 // --- OpenCV FileStorage ------------------------------------------------------------------------
 
+// Offset of the first byte that is not text (a control character other than tab, CR, LF; DEL; a
+// malformed or overlong UTF-8 sequence), or npos.
+std::size_t firstNonText(const std::string& s) {
+  std::size_t i = 0;
+  while (i < s.size()) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    if (c < 0x80) {
+      if ((c < 0x20 && c != '\t' && c != '\r' && c != '\n') || c == 0x7F) return i;
+      ++i;
+      continue;
+    }
+    const int len = c >= 0xC2 && c <= 0xDF   ? 2
+                    : c >= 0xE0 && c <= 0xEF ? 3
+                    : c >= 0xF0 && c <= 0xF4 ? 4
+                                             : 0;
+    if (len == 0 || i + static_cast<std::size_t>(len) > s.size()) return i;
+    for (int k = 1; k < len; ++k) {
+      if ((static_cast<unsigned char>(s[i + static_cast<std::size_t>(k)]) & 0xC0) != 0x80) return i;
+    }
+    i += static_cast<std::size_t>(len);
+  }
+  return std::string::npos;
+}
+
 // The numbers of a node: an !!opencv-matrix, a (nested) list, or one number. False if the node
 // holds anything else.
 bool numbersOf(const cv::FileNode& n, std::vector<double>* out) {
   if (n.isMap()) {
+    // The header is checked before OpenCV reads the matrix: it sizes the matrix from rows and
+    // cols as they stand, and a damaged header made it ask for 48 GB (found by fuzzing).
+    constexpr int kMaxSide = 64;  // a calibration matrix or distortion vector is far smaller
+    const cv::FileNode rows = n["rows"];
+    const cv::FileNode cols = n["cols"];
+    const cv::FileNode data = n["data"];
+    if (!rows.isInt() || !cols.isInt() || !data.isSeq()) return false;
+    const int r = static_cast<int>(rows);
+    const int c = static_cast<int>(cols);
+    if (r < 1 || r > kMaxSide || c < 1 || c > kMaxSide ||
+        data.size() != static_cast<std::size_t>(r) * static_cast<std::size_t>(c)) {
+      return false;
+    }
     cv::Mat m;
     cv::read(n, m);
     if (m.empty()) return false;
@@ -298,6 +335,12 @@ Expected<RawStereoCalibration> readOpenCvStereo(const std::string& path) {
   std::ostringstream whole;
   whole << in.rdbuf();
   std::string text = whole.str();
+  // OpenCV 4.6's YAML parser loops forever on some invalid bytes (found by fuzzing: a 0xFF run
+  // after "%YA"), so only text reaches it: printable ASCII, tab, CR, LF and well-formed UTF-8.
+  if (const std::size_t bad = firstNonText(text); bad != std::string::npos) {
+    return parseError(fileName(path) + ": byte " + std::to_string(bad) +
+                      " is not text (a calibration file is ASCII or UTF-8)");
+  }
   // OpenCV 4.6 reads YAML only after a "%YAML" line ("Input file is invalid" otherwise); a
   // hand-written file without one is read as YAML too.
   const std::size_t first = text.find_first_not_of(" \t\r\n");
@@ -313,6 +356,10 @@ Expected<RawStereoCalibration> readOpenCvStereo(const std::string& path) {
     SUNVO_RETURN_IF_ERROR(readOpenCvFields(fs, path, &c));
   } catch (const cv::Exception& e) {
     return parseError(fileName(path) + ": not a readable OpenCV YAML/XML file: " + e.msg);
+  } catch (const std::exception& e) {
+    // FileStorage also lets standard exceptions out (std::length_error on a damaged matrix
+    // header; found by fuzzing).
+    return parseError(fileName(path) + ": not a readable OpenCV YAML/XML file: " + e.what());
   }
   const Status s = c.validate();
   if (!s.isOk()) return s;
@@ -338,6 +385,8 @@ Expected<RawStereoCalibration> readKalibrCamchain(const std::string& path) {
     SUNVO_RETURN_IF_ERROR(kalibrNumbers(root["cam1"], path, "cam1", "T_cn_cnm1", 16, &T));
   } catch (const YAML::Exception& e) {
     return parseError(fileName(path) + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
+  } catch (const std::exception& e) {
+    return parseError(fileName(path) + ": not a readable Kalibr camchain: " + e.what());
   }
   if (left.model != right.model) {
     return keyError(path, "cam1.distortion_model", "differs from cam0's");
