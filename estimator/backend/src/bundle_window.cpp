@@ -75,10 +75,6 @@ Status BundleWindow::init(const WindowOptions& options, const StereoCamera& came
   entries_.assign(n_pool, Entry{});
   measurements_.assign(n_pool, StereoMeasurement{});
   cost_pool_.clear();
-  cost_pool_.reserve(n_pool);
-  for (std::size_t i = 0; i < n_pool; ++i) {
-    cost_pool_.emplace_back(StereoResidual::Create(&measurements_[i], &model_));
-  }
   for (std::size_t s = 0; s < frames_.size(); ++s) {
     frames_[s].has_prior = false;
     prior_pool_[s].reset(MotionPriorResidual::Create(&frames_[s].prior));
@@ -97,16 +93,23 @@ Status BundleWindow::init(const WindowOptions& options, const StereoCamera& came
       loss_ = std::make_unique<ceres::CauchyLoss>(options.loss_scale);
       break;
   }
-  quaternion_manifold_ = std::make_unique<ceres::EigenQuaternionManifold>();
 
-  const int max_generic = static_cast<int>(residual_ids_.size()) - static_cast<int>(n_pool);
-  SUNVO_RETURN_IF_ERROR(schur_.init(static_cast<int>(n_pool), options.max_landmarks, max_generic));
-  schur_.setStereoModel(&model_);
-  if (options.solver != WindowSolver::kCeres) {
+  if (options.solver == WindowSolver::kSchurLm) {
+    // The stereo residuals are evaluated in closed form from measurements_: no cost functions.
+    const int max_generic = static_cast<int>(residual_ids_.size()) - static_cast<int>(n_pool);
+    SUNVO_RETURN_IF_ERROR(
+        schur_.init(static_cast<int>(n_pool), options.max_landmarks, max_generic));
+    schur_.setStereoModel(&model_);
     initialized_ = true;
     reset(Isometry3::Identity());
     return Status::ok();
   }
+  // Ceres: one autodiff stereo cost function per measurement slot, the manifold, the problem.
+  cost_pool_.reserve(n_pool);
+  for (std::size_t i = 0; i < n_pool; ++i) {
+    cost_pool_.emplace_back(StereoResidual::Create(&measurements_[i], &model_));
+  }
+  quaternion_manifold_ = std::make_unique<ceres::EigenQuaternionManifold>();
   ceres::Problem::Options po;
   po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;

@@ -216,7 +216,7 @@ class BundleWindow {
   std::vector<std::array<double, 3>> landmarks_;  // p_b, max_landmarks
   std::vector<Entry> entries_;                    // window_size * max_observations_per_frame
   std::vector<StereoMeasurement> measurements_;   // one per stereo cost function
-  std::vector<std::unique_ptr<ceres::CostFunction>> cost_pool_;
+  std::vector<std::unique_ptr<ceres::CostFunction>> cost_pool_;  // solver == kCeres only
   std::array<std::unique_ptr<ceres::CostFunction>, kMaxWindowSize> prior_pool_;
   std::vector<ceres::ResidualBlockId> residual_ids_;
   int num_residuals_ = 0;
