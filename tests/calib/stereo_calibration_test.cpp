@@ -217,6 +217,9 @@ TEST(CalibrationReaders, GarbageIsAnErrorNotAnException) {
       "%YA\xb4\xff\xff\xff.0\n---\xff\xff\xff%YAML\xff\xff:1.0\n\xff\xff---\nK1: !!opencv-matrix\n"
       "   rows:\xff 3\n   cols: 3\n   dt: d\n   data: [ 500., 0., 322., 0., 501., 238., 0., 0., 1. "
       "]\n",
+      // and on this one, whose only non-ASCII bytes are one well-formed UTF-8 character.
+      "%Y5\n   dt:eAML:1.0\n--\n- K!1:!opencv-m., 0., 501. 5\n   dt:e_width: 64\xf2\x96\x92\x9e"
+      "ge_height: 48\n ",
   };
   int k = 0;
   for (const std::string& text : inputs) {
