@@ -41,15 +41,8 @@ void StereoFrontend::computeGradients(const cv::Mat& img, int img_index) {
     const std::uint8_t* pm = img.ptr<std::uint8_t>(y - 1);
     const std::uint8_t* p0 = img.ptr<std::uint8_t>(y);
     const std::uint8_t* pp = img.ptr<std::uint8_t>(y + 1);
-    std::uint8_t* __restrict ox = gx + static_cast<std::ptrdiff_t>(y) * stride_;
-    std::uint8_t* __restrict oy = gy + static_cast<std::ptrdiff_t>(y) * stride_;
-    for (int x = 1; x + 1 < w; ++x) {
-      const int dx =
-          (pm[x + 1] + 2 * p0[x + 1] + pp[x + 1]) - (pm[x - 1] + 2 * p0[x - 1] + pp[x - 1]);
-      const int dy = (pp[x - 1] + 2 * pp[x] + pp[x + 1]) - (pm[x - 1] + 2 * pm[x] + pm[x + 1]);
-      ox[x] = static_cast<std::uint8_t>(std::clamp((dx >> 1) + 128, 0, 255));
-      oy[x] = static_cast<std::uint8_t>(std::clamp((dy >> 1) + 128, 0, 255));
-    }
+    gradientRow(pm, p0, pp, gx + static_cast<std::ptrdiff_t>(y) * stride_,
+                gy + static_cast<std::ptrdiff_t>(y) * stride_, w);
   }
 }
 
@@ -91,7 +84,9 @@ void StereoFrontend::describeAt(int img_index, int u, int v, std::uint8_t* d) co
 // likewise the min); a pixel is a candidate when r == M and |r| >= threshold. Equal values in one
 // window (plateaus) are resolved exactly afterwards: the earliest pixel in row-major order wins,
 // so exactly one pixel of a plateau survives. All loops are simple passes over rows that the
-// compiler vectorises.
+// compiler vectorises. (Checking only the horizontal extrema against the other rows, instead of
+// the vertical pass, was measured slower: about 7 % of the pixels are horizontal extrema over
+// the threshold on KITTI frames, and their sparse column reads cost more than the pass.)
 void StereoFrontend::detect(const cv::Mat& img_in, int img_index, CandidateSet& set) {
   smooth(img_in);
   const cv::Mat img(img_in.rows, img_in.cols, CV_8UC1, smooth_.data(),
@@ -151,11 +146,7 @@ void StereoFrontend::detect(const cv::Mat& img_in, int img_index, CandidateSet& 
         const std::ptrdiff_t strip_off = off - first;
         const std::int16_t* vmax = nms_max_.data() + strip_off;
         const std::int16_t* vmin = nms_min_.data() + strip_off;
-        for (int x = x0; x < x1; ++x) {
-          const int is_max = (row[x] == vmax[x]) & (row[x] >= pos_thr);
-          const int is_min = (row[x] == vmin[x]) & (row[x] <= neg_thr);
-          flags[x] = static_cast<std::uint8_t>(is_max | (is_min << 1));
-        }
+        flagRow(row, vmax, vmin, pos_thr, neg_thr, flags, x0, x1);
         std::memset(flags + x1, 0, 8);  // so that the last 8-byte word reads no stale flags
         // Visit the non-zero flag bytes, 8 at a time (little-endian: byte i = bits 8i .. 8i+7).
         for (int xw = x0; xw < x1; xw += 8) {

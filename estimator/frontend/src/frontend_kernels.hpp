@@ -3,9 +3,11 @@
 // (stereo_frontend.cpp) translation units. Private to estimator/frontend.
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <ctime>
@@ -90,20 +92,40 @@ inline std::int64_t rowSsd(const std::uint8_t* __restrict a, const std::uint8_t*
   return sum;
 }
 
+// The image kernels below are defined in frontend_kernels.cpp. On x86-64 each is compiled twice,
+// for the baseline (SSE2) and for AVX2, and the loader picks one per CPU (GCC/Clang function
+// multiversioning): the package stays runnable on any x86-64 while a CPU with AVX2 does twice the
+// lanes per instruction. They are integer-only, so both versions give bit-identical results.
+// restrict-qualified parameters let the compiler vectorise without alias checks.
+
 // out_max[i] = max(a[i], b[i]), out_min[i] = min(c[i], d[i]) for i in [0, count). Inputs may
-// overlap each other (they are only read). noinline: the restrict qualifiers, and with them
-// vectorisation without alias checks, survive only on parameters.
-[[gnu::noinline]] inline void maxMinOf(const std::int16_t* __restrict a,
-                                       const std::int16_t* __restrict b,
-                                       const std::int16_t* __restrict c,
-                                       const std::int16_t* __restrict d,
-                                       std::int16_t* __restrict out_max,
-                                       std::int16_t* __restrict out_min, std::ptrdiff_t count) {
-  for (std::ptrdiff_t i = 0; i < count; ++i) {
-    out_max[i] = std::max(a[i], b[i]);
-    out_min[i] = std::min(c[i], d[i]);
-  }
-}
+// overlap each other (they are only read).
+void maxMinOf(const std::int16_t* __restrict a, const std::int16_t* __restrict b,
+              const std::int16_t* __restrict c, const std::int16_t* __restrict d,
+              std::int16_t* __restrict out_max, std::int16_t* __restrict out_min,
+              std::ptrdiff_t count);
+
+// One row of the binomial smoothing (see StereoFrontend::smooth()), x in [1, w-1).
+void smoothRow(const std::uint8_t* __restrict pm, const std::uint8_t* __restrict p0,
+               const std::uint8_t* __restrict pp, std::uint8_t* __restrict out, int w);
+
+// One row of the Sobel gradients (see StereoFrontend::computeGradients()), x in [1, w-1).
+void gradientRow(const std::uint8_t* __restrict pm, const std::uint8_t* __restrict p0,
+                 const std::uint8_t* __restrict pp, std::uint8_t* __restrict ox,
+                 std::uint8_t* __restrict oy, int w);
+
+// One row of the blob and corner responses (see StereoFrontend::computeResponses()),
+// x in [2, w-2).
+void responseRow(const std::uint8_t* __restrict m2, const std::uint8_t* __restrict m1,
+                 const std::uint8_t* __restrict p0, const std::uint8_t* __restrict p1,
+                 const std::uint8_t* __restrict p2, std::int16_t* __restrict ob,
+                 std::int16_t* __restrict oc, int w);
+
+// Candidate flags of one row, x in [x0, x1): bit 0 where r == vmax and r >= pos_thr (a maximum
+// over the threshold), bit 1 where r == vmin and r <= neg_thr.
+void flagRow(const std::int16_t* __restrict r, const std::int16_t* __restrict vmax,
+             const std::int16_t* __restrict vmin, std::int16_t pos_thr, std::int16_t neg_thr,
+             std::uint8_t* __restrict flags, int x0, int x1);
 
 // Running max and min over L = 2n+1 samples spaced `step` apart in flat arrays of `total`
 // elements: out_max[i] = max over in_max[i + k step], out_min[i] = min over in_min[i + k step],
@@ -133,37 +155,6 @@ inline void windowMaxMin(const std::int16_t* in_max, const std::int16_t* in_min,
   }
   maxMinOf(cur_max, cur_max + (L - span) * step, cur_min, cur_min + (L - span) * step,
            out_max + n * step, out_min + n * step, total - (L - 1) * step);
-}
-
-// One row of the binomial smoothing (see smooth()), x in [1, w-1).
-[[gnu::noinline]] inline void smoothRow(const std::uint8_t* __restrict pm,
-                                        const std::uint8_t* __restrict p0,
-                                        const std::uint8_t* __restrict pp,
-                                        std::uint8_t* __restrict out, int w) {
-  for (int x = 1; x + 1 < w; ++x) {
-    const int c = 4 * p0[x] + 2 * (p0[x - 1] + p0[x + 1] + pm[x] + pp[x]) + pm[x - 1] + pm[x + 1] +
-                  pp[x - 1] + pp[x + 1];
-    out[x] = static_cast<std::uint8_t>((c + 8) >> 4);
-  }
-}
-
-// One row of the blob and corner responses (see computeResponses); restrict-qualified
-// parameters let the compiler vectorise without alias checks.
-[[gnu::noinline]] inline void responseRow(const std::uint8_t* __restrict m2,
-                                          const std::uint8_t* __restrict m1,
-                                          const std::uint8_t* __restrict p0,
-                                          const std::uint8_t* __restrict p1,
-                                          const std::uint8_t* __restrict p2,
-                                          std::int16_t* __restrict ob, std::int16_t* __restrict oc,
-                                          int w) {
-  for (int x = 2; x + 2 < w; ++x) {
-    const int ring =
-        m2[x - 2] + m2[x] + m2[x + 2] + p0[x - 2] + p0[x + 2] + p2[x - 2] + p2[x] + p2[x + 2];
-    ob[x] = static_cast<std::int16_t>(8 * p0[x] - ring);
-    const int outer = m2[x - 2] + p2[x + 2] - m2[x + 2] - p2[x - 2];
-    const int inner = m1[x - 1] + p1[x + 1] - m1[x + 1] - p1[x - 1];
-    oc[x] = static_cast<std::int16_t>(outer + 2 * inner);
-  }
 }
 
 }  // namespace sunvo::frontend_detail
