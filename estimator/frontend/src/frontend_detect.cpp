@@ -79,14 +79,15 @@ void StereoFrontend::describeAt(int img_index, int u, int v, std::uint8_t* d) co
   }
 }
 
-// Non-maximum suppression with a separable (2n+1)^2 max/min filter: M = max over the window is
-// computed as a horizontal running max per row followed by a vertical max over 2n+1 rows (and
-// likewise the min); a pixel is a candidate when r == M and |r| >= threshold. Equal values in one
-// window (plateaus) are resolved exactly afterwards: the earliest pixel in row-major order wins,
-// so exactly one pixel of a plateau survives. All loops are simple passes over rows that the
-// compiler vectorises. (Checking only the horizontal extrema against the other rows, instead of
-// the vertical pass, was measured slower: about 7 % of the pixels are horizontal extrema over
-// the threshold on KITTI frames, and their sparse column reads cost more than the pass.)
+// Non-maximum suppression with a separable (2n+1)^2 max/min filter: a horizontal running max
+// per row (flat doubling passes over the strip, windowMaxMin), then per candidate row the max over
+// the 2n+1 rows of it around, fused with the flag test (windowFlags: nothing of the vertical pass
+// is stored); likewise the min. A pixel is a candidate when r == M and |r| >= threshold. Equal
+// values in one window (plateaus) are resolved exactly afterwards: the earliest pixel in
+// row-major order wins, so exactly one pixel of a plateau survives. All loops are simple passes
+// over rows that the compiler vectorises. (Measured and not kept: checking only the horizontal
+// extrema against the other rows, a sparse read of about 7 % of the pixels, was slower than the
+// vertical pass; so were a direct (2n+1)-tap horizontal max and row-by-row doubling.)
 void StereoFrontend::detect(const cv::Mat& img_in, int img_index, CandidateSet& set) {
   smooth(img_in);
   const cv::Mat img(img_in.rows, img_in.cols, CV_8UC1, smooth_.data(),
@@ -106,17 +107,18 @@ void StereoFrontend::detect(const cv::Mat& img_in, int img_index, CandidateSet& 
 
   // true if no pixel of the window beats r(x, y) (sign +1: max, -1: min) or equals it earlier.
   // Called where r(x, y) equals the window max (or min), i.e. nothing in the window beats it;
-  // true unless an equal value comes earlier in row-major order. Branch-free inner loop.
+  // true unless an equal value comes earlier in row-major order: in one of the n rows above
+  // (2n+1 pixels each) or left of it in its own row (n pixels), 8 pixels per compare.
   auto isFirstExtremum = [&](const std::int16_t* r, int x, int y) {
     const std::int16_t c = r[static_cast<std::ptrdiff_t>(y) * stride_ + x];
-    int equal = 0;
-    for (int yy = y - n; yy < y; ++yy) {
+    for (int yy = y - n; yy <= y; ++yy) {
       const std::int16_t* row = r + static_cast<std::ptrdiff_t>(yy) * stride_ + x - n;
-      for (int k = 0; k <= 2 * n; ++k) equal |= (row[k] == c) ? 1 : 0;
+      const int len = yy < y ? 2 * n + 1 : n;
+      for (int k = 0; k < len; k += 8) {
+        if (anyEqual8(row + k, std::min(8, len - k), c)) return false;
+      }
     }
-    const std::int16_t* row = r + static_cast<std::ptrdiff_t>(y) * stride_ + x - n;
-    for (int k = 0; k < n; ++k) equal |= (row[k] == c) ? 1 : 0;
-    return equal == 0;
+    return true;
   };
 
   const int x0 = b;
@@ -132,11 +134,10 @@ void StereoFrontend::detect(const cv::Mat& img_in, int img_index, CandidateSet& 
     const std::ptrdiff_t total = static_cast<std::ptrdiff_t>(ye - ys + 2 * n) * stride_;
     for (int type = 0; type < 2; ++type) {
       const std::int16_t* r = responses[type];
-      // (2n+1)^2 max and min: horizontal then vertical running max/min.
+      // Horizontal (2n+1) max and min of the strip's rows and their n-row margins; the
+      // vertical max/min over 2n+1 of those rows is taken per row inside windowFlags().
       // The NMS buffers hold one strip: their row 0 is image row ys - n.
       windowMaxMin(r + first, r + first, nms_hmax_.data(), nms_hmin_.data(), tmp, 1, n, total);
-      windowMaxMin(nms_hmax_.data(), nms_hmin_.data(), nms_max_.data(), nms_min_.data(), tmp,
-                   stride_, n, total);
       const int thr = thresholds[type];
       const auto pos_thr = static_cast<std::int16_t>(thr);
       const auto neg_thr = static_cast<std::int16_t>(-thr);
@@ -144,11 +145,11 @@ void StereoFrontend::detect(const cv::Mat& img_in, int img_index, CandidateSet& 
         const std::ptrdiff_t off = static_cast<std::ptrdiff_t>(y) * stride_;
         const std::int16_t* row = r + off;
         const std::ptrdiff_t strip_off = off - first;
-        const std::int16_t* vmax = nms_max_.data() + strip_off;
-        const std::int16_t* vmin = nms_min_.data() + strip_off;
-        flagRow(row, vmax, vmin, pos_thr, neg_thr, flags, x0, x1);
+        windowFlags(row, nms_hmax_.data() + strip_off, nms_hmin_.data() + strip_off, stride_, n,
+                    pos_thr, neg_thr, flags, x0, x1);
         std::memset(flags + x1, 0, 8);  // so that the last 8-byte word reads no stale flags
         // Visit the non-zero flag bytes, 8 at a time (little-endian: byte i = bits 8i .. 8i+7).
+        // (Skipping 32-byte blocks without a flag first was measured: no gain.)
         for (int xw = x0; xw < x1; xw += 8) {
           std::uint64_t word = 0;
           std::memcpy(&word, flags + xw, sizeof(word));

@@ -80,15 +80,62 @@ SUNVO_SIMD_CLONES void responseRow(const std::uint8_t* __restrict m2,
   }
 }
 
-SUNVO_SIMD_CLONES void flagRow(const std::int16_t* __restrict r,
-                               const std::int16_t* __restrict vmax,
-                               const std::int16_t* __restrict vmin, std::int16_t pos_thr,
-                               std::int16_t neg_thr, std::uint8_t* __restrict flags, int x0,
-                               int x1) {
+namespace {
+
+// Flags of one row from the 2N + 1 rows of the horizontal max/min around it (row k at
+// hmax + k stride, k = -N .. N): the window max is the max over those rows.
+template <int N>
+[[gnu::always_inline]] inline void windowFlagsN(const std::int16_t* __restrict r,
+                                                const std::int16_t* __restrict hmax,
+                                                const std::int16_t* __restrict hmin,
+                                                std::ptrdiff_t stride, std::int16_t pos_thr,
+                                                std::int16_t neg_thr,
+                                                std::uint8_t* __restrict flags, int x0, int x1) {
   for (int x = x0; x < x1; ++x) {
-    const int is_max = (r[x] == vmax[x]) & (r[x] >= pos_thr);
-    const int is_min = (r[x] == vmin[x]) & (r[x] <= neg_thr);
+    std::int16_t vmax = hmax[x - N * stride];
+    std::int16_t vmin = hmin[x - N * stride];
+    for (int k = -N + 1; k <= N; ++k) {
+      vmax = std::max(vmax, hmax[x + k * stride]);
+      vmin = std::min(vmin, hmin[x + k * stride]);
+    }
+    const int is_max = (r[x] == vmax) & (r[x] >= pos_thr);
+    const int is_min = (r[x] == vmin) & (r[x] <= neg_thr);
     flags[x] = static_cast<std::uint8_t>(is_max | (is_min << 1));
+  }
+}
+
+}  // namespace
+
+SUNVO_SIMD_CLONES void windowFlags(const std::int16_t* __restrict r,
+                                   const std::int16_t* __restrict hmax,
+                                   const std::int16_t* __restrict hmin, std::ptrdiff_t stride,
+                                   int n, std::int16_t pos_thr, std::int16_t neg_thr,
+                                   std::uint8_t* __restrict flags, int x0, int x1) {
+  switch (n) {
+    case 1:
+      windowFlagsN<1>(r, hmax, hmin, stride, pos_thr, neg_thr, flags, x0, x1);
+      break;
+    case 2:
+      windowFlagsN<2>(r, hmax, hmin, stride, pos_thr, neg_thr, flags, x0, x1);
+      break;
+    case 3:
+      windowFlagsN<3>(r, hmax, hmin, stride, pos_thr, neg_thr, flags, x0, x1);
+      break;
+    case 4:
+      windowFlagsN<4>(r, hmax, hmin, stride, pos_thr, neg_thr, flags, x0, x1);
+      break;
+    case 5:
+      windowFlagsN<5>(r, hmax, hmin, stride, pos_thr, neg_thr, flags, x0, x1);
+      break;
+    case 6:
+      windowFlagsN<6>(r, hmax, hmin, stride, pos_thr, neg_thr, flags, x0, x1);
+      break;
+    case 7:
+      windowFlagsN<7>(r, hmax, hmin, stride, pos_thr, neg_thr, flags, x0, x1);
+      break;
+    default:
+      windowFlagsN<8>(r, hmax, hmin, stride, pos_thr, neg_thr, flags, x0, x1);
+      break;
   }
 }
 

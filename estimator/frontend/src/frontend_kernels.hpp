@@ -67,6 +67,29 @@ inline int sad32(const std::uint8_t* a, const std::uint8_t* b) {
 #endif
 }
 
+// True if one of r[0], ..., r[count - 1] equals c; count in [0, 8]. Reads r[0..7] whatever
+// count is (the caller keeps that inside the buffer).
+inline bool anyEqual8(const std::int16_t* r, int count, std::int16_t c) {
+#if defined(__SSE2__)
+  const __m128i eq =
+      _mm_cmpeq_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(r)), _mm_set1_epi16(c));
+  // movemask gives two bits per 16-bit lane; keep the first count lanes.
+  const auto bits = static_cast<unsigned>(_mm_movemask_epi8(eq));
+  return (bits & ((1U << (2 * count)) - 1U)) != 0;
+#elif defined(__ARM_NEON) && defined(__aarch64__)
+  static constexpr std::int16_t kLane[8] = {0, 1, 2, 3, 4, 5, 6, 7};
+  const uint16x8_t eq = vceqq_s16(vld1q_s16(r), vdupq_n_s16(c));
+  const uint16x8_t keep =
+      vcltq_s16(vld1q_s16(kLane), vdupq_n_s16(static_cast<std::int16_t>(count)));
+  return vmaxvq_u16(vandq_u16(eq, keep)) != 0;
+#else
+  for (int k = 0; k < count; ++k) {
+    if (r[k] == c) return true;
+  }
+  return false;
+#endif
+}
+
 // Descriptor sample offsets: a 4x4 grid spanning 13x13 px around the keypoint.
 constexpr std::array<int, 4> kGrid = {-6, -2, 2, 6};
 constexpr int kDescriptorReach = 6;  // px, largest |offset|
@@ -121,11 +144,14 @@ void responseRow(const std::uint8_t* __restrict m2, const std::uint8_t* __restri
                  const std::uint8_t* __restrict p2, std::int16_t* __restrict ob,
                  std::int16_t* __restrict oc, int w);
 
-// Candidate flags of one row, x in [x0, x1): bit 0 where r == vmax and r >= pos_thr (a maximum
-// over the threshold), bit 1 where r == vmin and r <= neg_thr.
-void flagRow(const std::int16_t* __restrict r, const std::int16_t* __restrict vmax,
-             const std::int16_t* __restrict vmin, std::int16_t pos_thr, std::int16_t neg_thr,
-             std::uint8_t* __restrict flags, int x0, int x1);
+// Candidate flags of one row, x in [x0, x1), from the horizontal max/min (hmax, hmin point at
+// this row; rows -n .. n at multiples of stride): with M the max over those 2n+1 rows (the
+// (2n+1)^2 window max) and m the min, bit 0 where r == M and r >= pos_thr, bit 1 where r == m
+// and r <= neg_thr. n in [1, 8].
+void windowFlags(const std::int16_t* __restrict r, const std::int16_t* __restrict hmax,
+                 const std::int16_t* __restrict hmin, std::ptrdiff_t stride, int n,
+                 std::int16_t pos_thr, std::int16_t neg_thr, std::uint8_t* __restrict flags, int x0,
+                 int x1);
 
 // Running max and min over L = 2n+1 samples spaced `step` apart in flat arrays of `total`
 // elements: out_max[i] = max over in_max[i + k step], out_min[i] = min over in_min[i + k step],

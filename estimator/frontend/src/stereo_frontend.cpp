@@ -100,8 +100,7 @@ Status StereoFrontend::init(const FrontendOptions& options, const StereoCamera& 
   corner_.assign(pixels, 0);
   const auto strip_pixels = static_cast<std::size_t>(options.max_width) *
                             static_cast<std::size_t>(kNmsStrip + 2 * options.nms_radius);
-  for (auto* buffer :
-       {&nms_a_, &nms_b_, &nms_c_, &nms_d_, &nms_hmax_, &nms_hmin_, &nms_max_, &nms_min_}) {
+  for (auto* buffer : {&nms_a_, &nms_b_, &nms_c_, &nms_d_, &nms_hmax_, &nms_hmin_}) {
     buffer->assign(strip_pixels, 0);
   }
   flag_row_.assign(static_cast<std::size_t>(options.max_width) + 8, 0);

@@ -213,16 +213,14 @@ class StereoFrontend {
   std::vector<std::uint8_t> smooth_;  // the smoothed current image
   std::vector<std::int16_t> blob_;
   std::vector<std::int16_t> corner_;
-  // NMS buffers of one strip (kNmsStrip + 2 nms_radius rows): doubling scratch, horizontal
-  // window max/min, (2n+1)^2 window max/min.
+  // NMS buffers of one strip (kNmsStrip + 2 nms_radius rows): doubling scratch and the
+  // horizontal (2n+1) window max/min (the vertical max/min is taken per row, not stored).
   std::vector<std::int16_t> nms_a_;
   std::vector<std::int16_t> nms_b_;
   std::vector<std::int16_t> nms_c_;
   std::vector<std::int16_t> nms_d_;
   std::vector<std::int16_t> nms_hmax_;
   std::vector<std::int16_t> nms_hmin_;
-  std::vector<std::int16_t> nms_max_;
-  std::vector<std::int16_t> nms_min_;
   std::vector<std::uint8_t> flag_row_;  // NMS: bit 0 max, bit 1 min candidate
   int stride_ = 0;
   int border_ = 0;  // px: candidates lie at least this far inside the image
