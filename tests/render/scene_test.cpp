@@ -103,5 +103,81 @@ TEST(Kitti, TimestampFormat) {
             "2011-09-26 13:02:25.967790592");
 }
 
+TEST(Scenario, RigErrorIsReadAndRangeChecked) {
+  auto a = parseScenario("rig_error: {right_roll_start_deg: 0.02, right_roll_end_deg: 0.08}\n",
+                         "t.yaml");
+  ASSERT_TRUE(a) << a.status().toString();
+  EXPECT_EQ(a->rig_error.right_roll_start_deg, 0.02);
+  EXPECT_EQ(a->rig_error.right_roll_end_deg, 0.08);
+  EXPECT_TRUE(a->rig_error.any());
+  EXPECT_FALSE(Scenario{}.rig_error.any());
+  auto b = parseScenario("rig_error: {right_pitch_end_deg: 3}\n", "t.yaml");
+  ASSERT_FALSE(b);
+  EXPECT_NE(b.status().message().find("rig_error.right_pitch_end_deg"), std::string::npos);
+  auto c = parseScenario("rig_error: {right_rol_end_deg: 0.1}\n", "t.yaml");
+  ASSERT_FALSE(c);
+  EXPECT_NE(c.status().message().find("rig_error.right_rol_end_deg"), std::string::npos);
+}
+
+// What the rendered images carry (small angles): a right-camera roll theta about its optical
+// axis makes vL - vR = theta (u - cu) fv / fu, a pitch delta makes vL - vR = -fv delta
+// (1 + ((v - cv) / fv)^2) (0.3 px at the centre row for delta = 0.3 / fv), both changing linearly
+// from the first to the last frame. Checked by projecting points through the nominal and the
+// turned right camera.
+TEST(Drive, RightCameraErrorTurnsTheRightCameraLinearlyOverTheDrive) {
+  const StereoCamera cam{721.5377, 721.5377, 609.5593, 172.854, 0.537, 1242, 375};
+  RigErrorOptions o;
+  o.right_roll_start_deg = 0.02;
+  o.right_roll_end_deg = 0.08;
+  o.right_pitch_start_deg = 0.0;
+  o.right_pitch_end_deg = 0.3 / cam.fv * 180.0 / 3.141592653589793;
+  const Eigen::Vector3d mid = rightCameraErrorDeg(o, 0.5);
+  EXPECT_NEAR(mid.x(), 0.05, 1e-12);
+  EXPECT_NEAR(mid.y(), 0.5 * o.right_pitch_end_deg, 1e-12);
+  EXPECT_EQ(rightCameraErrorDeg(o, 2.0), rightCameraErrorDeg(o, 1.0));  // clamped
+  EXPECT_TRUE(rightCameraError(RigErrorOptions{}, 0.7).isApprox(Isometry3::Identity()));
+  for (const double progress : {0.0, 1.0}) {
+    const Eigen::Vector3d e = rightCameraErrorDeg(o, progress) * 3.141592653589793 / 180.0;
+    const Isometry3 T_c1nom_c1 = rightCameraError(o, progress);
+    for (const Eigen::Vector3d& p_c1nom :
+         {Eigen::Vector3d(-8, 1, 20), Eigen::Vector3d(6, -2, 15), Eigen::Vector3d(0.5, 0.2, 30)}) {
+      const Eigen::Vector3d p_c1 = T_c1nom_c1.inverse() * p_c1nom;
+      const double u_nom = cam.cu + cam.fu * p_c1nom.x() / p_c1nom.z();
+      const double v_nom = cam.cv + cam.fv * p_c1nom.y() / p_c1nom.z();  // = vL of a true rig
+      const double v_right = cam.cv + cam.fv * p_c1.y() / p_c1.z();
+      const double y_n = (v_nom - cam.cv) / cam.fv;  // the pitch term grows off-centre
+      const double expected =
+          e.x() * (u_nom - cam.cu) * cam.fv / cam.fu - cam.fv * e.y() * (1.0 + y_n * y_n);
+      EXPECT_NEAR(v_nom - v_right, expected, 2e-3) << "progress " << progress;
+    }
+  }
+}
+
+TEST(Scenario, DriftBenchmarkTwinsDifferOnlyInTheRigAndAreLongerThanThreeKilometres) {
+  auto bad = loadScenario(std::string(SUNVO_SOURCE_DIR) +
+                          "/config/scenarios/bench_drift_miscalibrated.yaml");
+  auto good =
+      loadScenario(std::string(SUNVO_SOURCE_DIR) + "/config/scenarios/bench_drift_calibrated.yaml");
+  ASSERT_TRUE(bad) << bad.status().toString();
+  ASSERT_TRUE(good) << good.status().toString();
+  EXPECT_TRUE(bad->rig_error.any());
+  EXPECT_FALSE(good->rig_error.any());
+  EXPECT_EQ(bad->seed, good->seed);
+  EXPECT_EQ(bad->frames, good->frames);
+  EXPECT_EQ(bad->start_utc, good->start_utc);
+  auto r = generateRoute(generateCity(bad->city, bad->seed), bad->route, bad->frames, bad->seed);
+  ASSERT_TRUE(r) << r.status().toString();
+  auto r2 =
+      generateRoute(generateCity(good->city, good->seed), good->route, good->frames, good->seed);
+  ASSERT_TRUE(r2) << r2.status().toString();
+  double len = 0;
+  for (std::size_t k = 1; k < r->size(); ++k) {
+    len += ((*r)[k].T_enu_b.translation() - (*r)[k - 1].T_enu_b.translation()).norm();
+    EXPECT_TRUE((*r)[k].T_enu_b.isApprox((*r2)[k].T_enu_b)) << k;
+  }
+  std::printf("bench_drift_*: %d frames, %.0f m\n", bad->frames, len);
+  EXPECT_GT(len, 3000.0);
+}
+
 }  // namespace
 }  // namespace sunvo::render

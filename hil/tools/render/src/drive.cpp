@@ -82,6 +82,24 @@ FrameLighting computeLighting(const Eigen::Vector3d& sun_enu, const SkyOptions& 
   return f;
 }
 
+Eigen::Vector3d rightCameraErrorDeg(const RigErrorOptions& o, double progress) {
+  const double t = std::clamp(progress, 0.0, 1.0);
+  auto lerp = [t](double a, double b) { return a + t * (b - a); };
+  return {lerp(o.right_roll_start_deg, o.right_roll_end_deg),
+          lerp(o.right_pitch_start_deg, o.right_pitch_end_deg),
+          lerp(o.right_yaw_start_deg, o.right_yaw_end_deg)};
+}
+
+Isometry3 rightCameraError(const RigErrorOptions& o, double progress) {
+  const Eigen::Vector3d rad = rightCameraErrorDeg(o, progress) * (kPi / 180.0);
+  Isometry3 T_c1nom_c1 = Isometry3::Identity();
+  T_c1nom_c1.linear() = (Eigen::AngleAxisd(rad.x(), Eigen::Vector3d::UnitZ()) *
+                         Eigen::AngleAxisd(rad.y(), Eigen::Vector3d::UnitX()) *
+                         Eigen::AngleAxisd(rad.z(), Eigen::Vector3d::UnitY()))
+                            .toRotationMatrix();
+  return T_c1nom_c1;
+}
+
 Status writeKittiCalibration(const std::string& dir, const StereoCamera& cam,
                              const CalibErrorOptions& err) {
   const double f_u = cam.fu * err.focal_scale, f_v = cam.fv * err.focal_scale;
@@ -195,7 +213,8 @@ Expected<std::string> renderDrive(const Scenario& s, const std::string& out_root
   const TimeNs dt_ns = static_cast<TimeNs>(std::llround(1e9 / s.route.rate_hz));
   std::string ts, poses, poses_enu,
       sun_c_csv = "frame,sx,sy,sz\n", sun_enu_csv = "frame,zenith_deg,azimuth_deg,e,n,u\n",
-      body_csv = "frame,utc_ns,e,n,u,roll_rad,pitch_rad,yaw_rad,ve,vn,vu\n";
+      body_csv = "frame,utc_ns,e,n,u,roll_rad,pitch_rad,yaw_rad,ve,vn,vu\n",
+      rig_csv = "frame,right_roll_deg,right_pitch_deg,right_yaw_deg\n";
   std::vector<RenderJob> render_jobs;
   std::vector<double> gains;
   std::vector<SensorOptions> frame_sensor;  // the look of each frame's camera
@@ -218,7 +237,8 @@ Expected<std::string> renderDrive(const Scenario& s, const std::string& out_root
     auto sp = sun::computeSolarPosition(t, spa);
     if (!sp) return sp.status();
     const Isometry3 T_enu_c0 = vs.T_enu_b * T_b_c0;
-    const Isometry3 T_enu_c1 = T_enu_c0 * T_c0_c1;
+    const double drive_fraction = s.frames > 1 ? static_cast<double>(k) / (s.frames - 1) : 0.0;
+    const Isometry3 T_enu_c1 = T_enu_c0 * T_c0_c1 * rightCameraError(s.rig_error, drive_fraction);
     if (k == 0) T_enu_c0_first = T_enu_c0;
     const int period = s.style.frames_per_look > 0 ? k / s.style.frames_per_look : 0;
     if (k == 0 || period != look_period) {
@@ -280,6 +300,12 @@ Expected<std::string> renderDrive(const Scenario& s, const std::string& out_root
                   static_cast<long long>(t), p_imu.x(), p_imu.y(), p_imu.z(), vs.roll_rad,
                   vs.pitch_rad, vs.yaw_rad, vs.v_enu.x(), vs.v_enu.y(), vs.v_enu.z());
     body_csv += buf;
+    {
+      const Eigen::Vector3d err_deg = rightCameraErrorDeg(s.rig_error, drive_fraction);
+      std::snprintf(buf, sizeof buf, "%d,%.6f,%.6f,%.6f\n", k, err_deg.x(), err_deg.y(),
+                    err_deg.z());
+      rig_csv += buf;
+    }
   }
   for (int c = 0; c < 4; ++c)
     SUNVO_RETURN_IF_ERROR(
@@ -289,6 +315,7 @@ Expected<std::string> renderDrive(const Scenario& s, const std::string& out_root
   SUNVO_RETURN_IF_ERROR(writeText(gt_dir + "/sun_cam0.csv", sun_c_csv));
   SUNVO_RETURN_IF_ERROR(writeText(gt_dir + "/sun_enu.csv", sun_enu_csv));
   SUNVO_RETURN_IF_ERROR(writeText(gt_dir + "/body_enu.csv", body_csv));
+  SUNVO_RETURN_IF_ERROR(writeText(gt_dir + "/rig_error.csv", rig_csv));
   std::snprintf(buf, sizeof buf, "%.9f %.9f %.3f\n", s.latitude_deg, s.longitude_deg, s.altitude_m);
   SUNVO_RETURN_IF_ERROR(writeText(gt_dir + "/origin.txt", buf));
   // OXTS records, as the GPS/INS of a KITTI drive would write them (times in UTC).

@@ -59,6 +59,24 @@ Status CalibErrorOptions::validate() const {
   return Status::ok();
 }
 
+Status RigErrorOptions::validate() const {
+  const std::pair<const char*, double> angles[] = {{"right_roll_start_deg", right_roll_start_deg},
+                                                   {"right_roll_end_deg", right_roll_end_deg},
+                                                   {"right_pitch_start_deg", right_pitch_start_deg},
+                                                   {"right_pitch_end_deg", right_pitch_end_deg},
+                                                   {"right_yaw_start_deg", right_yaw_start_deg},
+                                                   {"right_yaw_end_deg", right_yaw_end_deg}};
+  for (const auto& [key, value] : angles) {
+    if (!(value >= -1.0 && value <= 1.0)) return range(std::string("rig_error.") + key, "[-1, 1]");
+  }
+  return Status::ok();
+}
+
+bool RigErrorOptions::any() const {
+  return right_roll_start_deg != 0.0 || right_roll_end_deg != 0.0 || right_pitch_start_deg != 0.0 ||
+         right_pitch_end_deg != 0.0 || right_yaw_start_deg != 0.0 || right_yaw_end_deg != 0.0;
+}
+
 Status Scenario::validate() const {
   if (name.empty() || name.find('/') != std::string::npos)
     return invalidArgument("name: empty or contains '/'");
@@ -78,6 +96,7 @@ Status Scenario::validate() const {
   SUNVO_RETURN_IF_ERROR(sensor.validate());
   SUNVO_RETURN_IF_ERROR(style.validate());
   SUNVO_RETURN_IF_ERROR(calib_error.validate());
+  SUNVO_RETURN_IF_ERROR(rig_error.validate());
   return Status::ok();
 }
 
@@ -93,7 +112,7 @@ Expected<Scenario> parseScenario(const std::string& text, const std::string& lab
   try {
     r.keys(root, "",
            {"name", "drive_number", "place", "start_utc", "frames", "seed", "sky", "city", "route",
-            "camera", "render", "sensor", "calib_error", "style"});
+            "camera", "render", "sensor", "calib_error", "style", "rig_error"});
     r.get(root, "", "name", s.name);
     r.get(root, "", "drive_number", s.drive_number);
     r.get(root, "", "frames", s.frames);
@@ -190,6 +209,16 @@ Expected<Scenario> parseScenario(const std::string& text, const std::string& lab
     r.get(ce, "calib_error", "cu_offset_px", s.calib_error.cu_offset_px);
     r.get(ce, "calib_error", "cv_offset_px", s.calib_error.cv_offset_px);
     r.get(ce, "calib_error", "baseline_scale", s.calib_error.baseline_scale);
+    const YAML::Node re = root["rig_error"];
+    r.keys(re, "rig_error",
+           {"right_roll_start_deg", "right_roll_end_deg", "right_pitch_start_deg",
+            "right_pitch_end_deg", "right_yaw_start_deg", "right_yaw_end_deg"});
+    r.get(re, "rig_error", "right_roll_start_deg", s.rig_error.right_roll_start_deg);
+    r.get(re, "rig_error", "right_roll_end_deg", s.rig_error.right_roll_end_deg);
+    r.get(re, "rig_error", "right_pitch_start_deg", s.rig_error.right_pitch_start_deg);
+    r.get(re, "rig_error", "right_pitch_end_deg", s.rig_error.right_pitch_end_deg);
+    r.get(re, "rig_error", "right_yaw_start_deg", s.rig_error.right_yaw_start_deg);
+    r.get(re, "rig_error", "right_yaw_end_deg", s.rig_error.right_yaw_end_deg);
   } catch (const YAML::Exception& e) {
     return parseError(label + ": YAML: " + e.what());
   }

@@ -38,6 +38,29 @@ struct CalibErrorOptions {
   Status validate() const;
 };
 
+// The rig as built differs from the rig as calibrated, slowly over the drive (temperature, a
+// knock to the mount): the right camera is turned by a rotation that goes linearly from *_start
+// (first frame) to *_end (last frame), in degrees about the right camera's own axes (roll about
+// z, the optical axis; pitch about x; yaw about y; applied as Rz(roll) Rx(pitch) Ry(yaw)). The
+// images carry it, the written calibration and camera 0's ground truth do not; the injected
+// angles per frame are written to gt/rig_error.csv. A right pitch of 0.3 px / fv rad is a 0.3 px
+// vertical offset. Each angle in [-1, 1] deg.
+struct RigErrorOptions {
+  double right_roll_start_deg = 0.0;
+  double right_roll_end_deg = 0.0;
+  double right_pitch_start_deg = 0.0;
+  double right_pitch_end_deg = 0.0;
+  double right_yaw_start_deg = 0.0;
+  double right_yaw_end_deg = 0.0;
+  Status validate() const;
+  bool any() const;
+};
+
+// The injected (roll, pitch, yaw) in degrees at `progress` (0 = first frame, 1 = last frame).
+Eigen::Vector3d rightCameraErrorDeg(const RigErrorOptions& o, double progress);
+// T_c1nominal_c1: the right camera's pose in the calibrated right-camera frame at `progress`.
+Isometry3 rightCameraError(const RigErrorOptions& o, double progress);
+
 struct Scenario {
   std::string name = "drive";
   int drive_number = 1;        // [0, 9999]
@@ -56,6 +79,7 @@ struct Scenario {
   SensorOptions sensor;
   StyleOptions style;  // domain randomisation of the look (style.hpp); seed 0 = classic
   CalibErrorOptions calib_error;
+  RigErrorOptions rig_error;
   Status validate() const;
 };
 
