@@ -151,6 +151,37 @@ TEST(StereoFrontend, ConstantDisparityIsRecoveredToSubpixel) {
   }
 }
 
+// A right image whose rows sit dv px lower than the left's (a rectification off by a fraction
+// of a pixel): with measure_v_right every match reports v_right - v_left = dv to subpixel
+// accuracy; dv = 0 gives 0. This is what the stereo self-calibration is fed from images.
+TEST(StereoFrontend, MeasuresTheRightRowToSubpixel) {
+  const cv::Mat texture = makeTexture(2);
+  const double d = 15.0;
+  FrontendOptions opt;
+  opt.measure_v_right = true;
+  for (const double dv : {0.0, 0.3, -0.2, 0.45}) {
+    StereoFrontend fe;
+    ASSERT_TRUE(fe.init(opt, syntheticCamera()).isOk());
+    FrameFeatures out;
+    // right(x, y) = texture(x + d, y - dv): a texture point at row Y is at Y + dv on the right.
+    ASSERT_TRUE(fe.process(crop(texture, 0, 0), crop(texture, d, -dv), 0, 0, out).isOk());
+    ASSERT_GE(out.observations.size(), 150u) << "dv = " << dv;
+    double sum = 0.0;
+    double sum_abs = 0.0;
+    for (const auto& o : out.observations) {
+      const double e = (o.v_right - o.v_left) - dv;
+      sum += e;
+      sum_abs += std::abs(e);
+    }
+    const auto n = static_cast<double>(out.observations.size());
+    std::printf(
+        "dv = %+.2f px: %zu matches, v_right - v_left error mean %+.3f px, mean |.| %.3f px\n", dv,
+        out.observations.size(), sum / n, sum_abs / n);
+    EXPECT_LT(std::abs(sum / n), 0.05) << "dv = " << dv;
+    EXPECT_LT(sum_abs / n, 0.12) << "dv = " << dv;
+  }
+}
+
 // Both images of frame 2 = frame 1 moved by (tx, ty) px: tracked features keep their ids and move
 // by exactly (tx, ty); nearly every feature that stays inside the image is tracked.
 TEST(StereoFrontend, KnownTranslationIsTrackedWithPersistentIds) {

@@ -217,15 +217,16 @@ int StereoFrontend::matchTemporal(const CandidateSet& from, int idx, const Candi
 }
 
 // Sum of squared differences of the gradient images (gx and gy) over a dense
-// (2 kRefineRadius + 1)^2 window: left centred at (ul, v), right at (ur, v).
-std::int64_t StereoFrontend::denseCost(int ul, int ur, int v) const {
+// (2 kRefineRadius + 1)^2 window: left centred at (ul, v), right at (ur, v + dv_right).
+std::int64_t StereoFrontend::denseCost(int ul, int ur, int v, int dv_right) const {
   std::int64_t sum = 0;
+  const std::ptrdiff_t shift = static_cast<std::ptrdiff_t>(dv_right) * stride_;
   for (int dy = -kRefineRadius; dy <= kRefineRadius; ++dy) {
     const std::ptrdiff_t row = static_cast<std::ptrdiff_t>(v + dy) * stride_;
     sum += rowSsd(gx_[0].data() + row + ul - kRefineRadius,
-                  gx_[1].data() + row + ur - kRefineRadius, 2 * kRefineRadius + 1);
+                  gx_[1].data() + row + shift + ur - kRefineRadius, 2 * kRefineRadius + 1);
     sum += rowSsd(gy_[0].data() + row + ul - kRefineRadius,
-                  gy_[1].data() + row + ur - kRefineRadius, 2 * kRefineRadius + 1);
+                  gy_[1].data() + row + shift + ur - kRefineRadius, 2 * kRefineRadius + 1);
   }
   return sum;
 }
@@ -238,7 +239,11 @@ std::int64_t StereoFrontend::denseCost(int ul, int ur, int v) const {
 // by boundary terms, so the cost is symmetric about its minimum and the parabola is unbiased,
 // whereas the sparse samples make it lopsided (0.2-0.3 px bias measured on exact shifts).
 // The window is centred on the left keypoint's whole pixel, so its subpixel offset du carries
-// over to the right: u_right = u_r + s + delta + du.
+// over to the right: u_right = u_r + s + delta + du. With measure_v_right the same cost is
+// sampled with the right window one row up and down at the refined column, and a parabola
+// through the three gives the right row: v_right = v_l + delta_v + dv (else v_right = v_left,
+// as rectification promises). A rig whose rectification is off by a fraction of a pixel shows it
+// there (what the stereo self-calibration estimates).
 bool StereoFrontend::refineStereo(int li, int ri, StereoObservation& obs) const {
   const CandidateSet& l = left_[static_cast<std::size_t>(cur_)];
   const CandidateSet& r = right_[static_cast<std::size_t>(cur_)];
@@ -246,7 +251,7 @@ bool StereoFrontend::refineStereo(int li, int ri, StereoObservation& obs) const 
   const Keypoint& rk = r.kp[static_cast<std::size_t>(ri)];
   std::array<std::int64_t, 5> cost{};
   for (int k = -2; k <= 2; ++k) {
-    cost[static_cast<std::size_t>(k + 2)] = denseCost(lk.u, rk.u + k, lk.v);
+    cost[static_cast<std::size_t>(k + 2)] = denseCost(lk.u, rk.u + k, lk.v, 0);
   }
   int s = 0;
   if (cost[1] < cost[2] && cost[1] <= cost[3]) s = -1;
@@ -264,6 +269,12 @@ bool StereoFrontend::refineStereo(int li, int ri, StereoObservation& obs) const 
   obs.v_left = v_left;
   obs.u_right = u_right;
   obs.v_right = v_left;  // rectified: the same row
+  if (options_.measure_v_right) {
+    const int ur = rk.u + s;
+    const float delta_v =
+        parabolaPeak(denseCost(lk.u, ur, lk.v, -1), cost[c], denseCost(lk.u, ur, lk.v, 1));
+    obs.v_right = v_left + static_cast<double>(delta_v);
+  }
   return true;
 }
 

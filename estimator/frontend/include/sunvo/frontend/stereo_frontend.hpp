@@ -64,6 +64,8 @@ struct FrontendOptions {
   int max_sad = 1200;                  // SAD of 32 uint8 samples, [1, 8160]: worse matches rejected
   double circular_tolerance_px = 1.5;  // px, [0, 100]: the circle must close this close
   int lr_tolerance = 1;                // px, [0, 10]: left->right->left check for new features
+  bool measure_v_right = false;        // subpixel right row of every match (else v_right =
+                                       //   v_left); what stereo self-calibration needs
 
   Status validate() const;
   template <class Self, class V>
@@ -86,6 +88,7 @@ struct FrontendOptions {
     v("max_sad", s.max_sad);
     v("circular_tolerance_px", s.circular_tolerance_px);
     v("lr_tolerance", s.lr_tolerance);
+    v("measure_v_right", s.measure_v_right);
   }
 };
 
@@ -197,7 +200,7 @@ class StereoFrontend {
   // centred on the candidate's position + (shift_u, shift_v).
   int matchTemporal(const CandidateSet& from, int idx, const CandidateSet& to, float shift_u,
                     float shift_v, int r) const;
-  std::int64_t denseCost(int ul, int ur, int v) const;
+  std::int64_t denseCost(int ul, int ur, int v, int dv_right) const;
   // Subpixel u of the right match ri of left candidate li (in the current frame); false if the
   // disparity falls outside the range.
   bool refineStereo(int li, int ri, StereoObservation& obs) const;
