@@ -67,6 +67,26 @@ TEST(StereoSelfCalibration, RecoversAnInjectedRightCameraRotation) {
   EXPECT_LT(r.roll_sigma_mrad, 0.01 * kDeg * 1e3);
 }
 
+// Observations whose right row was not measured (v_right_measured = false: the image front end
+// found no row information in the window) carry no information and are not used, whatever their
+// v_right says.
+TEST(StereoSelfCalibration, UnmeasuredRightRowsAreNotUsed) {
+  auto frames = tracks(50, 0.3);
+  miscalibrate(frames, 0.2 * kDeg, 0.0);
+  for (FrameFeatures& f : frames) {
+    for (StereoObservation& o : f.observations) o.v_right_measured = false;
+  }
+  StereoSelfCalibration cal;
+  ASSERT_TRUE(cal.init(on(), camera()).isOk());
+  FrameFeatures out;
+  SelfCalibrationReport r;
+  for (const FrameFeatures& f : frames) r = cal.process(f, &out);
+  EXPECT_FALSE(r.updated);
+  EXPECT_EQ(r.used, 0);
+  EXPECT_EQ(r.pitch_mrad, 0.0);
+  EXPECT_EQ(r.roll_mrad, 0.0);
+}
+
 TEST(StereoSelfCalibration, CorrectsTheDisparityAndLeavesCleanDataAlone) {
   const auto clean = tracks(120, 0.0);
   auto bent = clean;

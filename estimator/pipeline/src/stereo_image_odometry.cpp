@@ -40,6 +40,11 @@ Status PipelineOptions::validate() const {
   if (!(max_hint_px >= 0.0 && max_hint_px <= 1000.0)) {
     return badKey("max_hint_px", "must be in [0, 1000] px");
   }
+  SUNVO_RETURN_IF_ERROR(self_calibration.validate());
+  if (self_calibration.enabled && !frontend.measure_v_right) {
+    return badKey("self_calibration.enabled",
+                  "needs frontend.measure_v_right: true (the right rows it learns from)");
+  }
   return Status::ok();
 }
 
@@ -53,6 +58,8 @@ Status StereoImageOdometry::init(const PipelineOptions& options, const StereoCam
   options_ = options;
   camera_ = camera;
   frontend_.reserveOutput(features_);
+  frontend_.reserveOutput(corrected_);
+  SUNVO_RETURN_IF_ERROR(self_calibration_.init(options.self_calibration, camera));
   have_motion_ = false;
   last_motion_ = Isometry3::Identity();
   initialized_ = true;
@@ -101,7 +108,14 @@ Expected<FrameResult> StereoImageOdometry::process(const StereoFrame& frame) {
   const std::uint64_t c1 = counter_ != nullptr ? counter_() : 0;
   const auto t1 = Clock::now();
   const double cpu1 = threadCpuMs();
-  Expected<vo::VoResult> vr = odometry_.process(features_);
+  // The self-calibration learns the right camera's turn from this frame's rows and corrects
+  // the right observations before the back end sees them.
+  const FrameFeatures* to_odometry = &features_;
+  if (self_calibration_.enabled()) {
+    r.self_calibration = self_calibration_.process(features_, &corrected_);
+    to_odometry = &corrected_;
+  }
+  Expected<vo::VoResult> vr = odometry_.process(*to_odometry);
   const std::uint64_t c2 = counter_ != nullptr ? counter_() : 0;
   const auto t2 = Clock::now();
   const double cpu2 = threadCpuMs();

@@ -72,6 +72,7 @@ SelfCalibrationReport StereoSelfCalibration::process(const FrameFeatures& in, Fr
   Eigen::Matrix3d info = Eigen::Matrix3d::Zero();
   Eigen::Vector3d b = Eigen::Vector3d::Zero();
   for (const StereoObservation& o : in.observations) {
+    if (!o.v_right_measured) continue;
     const Eigen::Vector3d H(-fv, -(o.u_right - cu), -(o.v_right - cv));
     const double y = o.v_left - o.v_right;
     if (!std::isfinite(y) || !H.allFinite() || std::abs(y - H.dot(x_)) > options_.gate_px) {

@@ -76,6 +76,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0, 100000));
   bool paper_form = false;
   app.add_flag("--paper-form", paper_form, "hold the base attitude fixed, as the paper did");
+  bool self_calib = false;
+  app.add_flag("--self-calib", self_calib,
+               "online stereo self-calibration of the right camera (measures the right rows)");
   app.add_option("--estimators", estimator_names,
                  "also VO + sun from these image estimators: lalonde, lalonde_vo, sun_cnn")
       ->delimiter(',')
@@ -88,6 +91,10 @@ int main(int argc, char** argv) {
       "also write each run's poses, OUT/replay_poses_<run>.txt (KITTI) and _tum.txt (TUM)");
   if (auto code = sunvo::cli::parse(app, argc, argv)) return *code;
   options.fusion.estimate_base_attitude = !paper_form;
+  if (self_calib) {
+    options.pipeline.frontend.measure_v_right = true;
+    options.pipeline.self_calibration.enabled = true;
+  }
   if (frames > 0) options.dataset.last_frame = frames - 1;
   std::erase(estimator_names, "none");
   if (auto s = options.validate(); !s.isOk()) {
@@ -146,6 +153,16 @@ int main(int argc, char** argv) {
                  static_cast<unsigned long long>(run->gate.accepted),
                  static_cast<unsigned long long>(run->gate.total()),
                  static_cast<unsigned long long>(run->gate.rejected_sun_down));
+    if (self_calib) {
+      const auto& sc = run->self_calibration;
+      std::fprintf(stderr,
+                   "  %-28s self-calibration: right pitch %+.4f deg, roll %+.4f deg (sigma "
+                   "%.4f), scale %+.2e, %llu resets\n",
+                   "", sc.pitch_mrad * 0.180 / 3.141592653589793,
+                   sc.roll_mrad * 0.180 / 3.141592653589793,
+                   sc.roll_sigma_mrad * 0.180 / 3.141592653589793, sc.scale,
+                   static_cast<unsigned long long>(sc.resets));
+    }
     if (run->sun_calls > 0) {
       std::fprintf(stderr, "  %-28s %d estimator calls, %.1f ms median, %.1f ms p90\n", "",
                    run->sun_calls, sunvo::metrics::percentile(run->sun_ms, 0.5),

@@ -140,6 +140,7 @@ Expected<ReplayRun> replayDrive(const dataset::Dataset& data, const ReplayOption
     run.T_w_c.push_back(r->vo.T_w_c);
     run.times_ns.push_back(frame.trigger_time_ns);
     run.frame_index.push_back(k);
+    run.self_calibration = r->self_calibration;
   }
   run.gate = vo.sunCounters();
   run.median_ms = metrics::percentile(ms, 0.5);

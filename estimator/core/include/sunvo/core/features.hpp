@@ -15,6 +15,9 @@ struct StereoObservation {
   double v_left = 0.0;
   double u_right = 0.0;  // px, rectified right image (v_right ~ v_left after rectification)
   double v_right = 0.0;
+  // false: the right row was not measured (v_right = v_left, as rectification promises) and
+  // carries no information about the rig (what stereo self-calibration learns from).
+  bool v_right_measured = true;
   double disparity() const { return u_left - u_right; }
 };
 

@@ -182,6 +182,11 @@ class StereoFrontend {
   static constexpr int kRefineRadius = 4;  // px, half size of the dense subpixel window
   static constexpr int kNmsStrip = 24;     // rows per NMS strip (cache blocking)
   static constexpr int kClasses = 4;
+  // measure_v_right: a match's right row is kept when its window's gradient structure is not
+  // an edge: the smaller eigenvalue of the Lucas-Kanade matrix at least this fraction of the
+  // larger (the row then at most ~2x less certain than the best-determined direction); else
+  // v_right_measured = false.
+  static constexpr double kMinRowCurvatureRatio = 0.25;
 
   // img_index 0 = left, 1 = right: which gradient buffers are written / read.
   void smooth(const cv::Mat& img);
@@ -204,6 +209,9 @@ class StereoFrontend {
   // Subpixel u of the right match ri of left candidate li (in the current frame); false if the
   // disparity falls outside the range.
   bool refineStereo(int li, int ri, StereoObservation& obs) const;
+  // measure_v_right: obs.v_right (and v_right_measured) of left keypoint lk matched at right
+  // column ur and row lk.v + sv (whole pixels), from the current gradient images.
+  void measureRightRow(const Keypoint& lk, int ur, int sv, StereoObservation& obs) const;
 
   FrontendOptions options_;
   StereoCamera camera_;

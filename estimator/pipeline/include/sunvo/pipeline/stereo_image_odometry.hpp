@@ -30,6 +30,7 @@
 #include "sunvo/core/status.hpp"
 #include "sunvo/core/stereo_frame.hpp"
 #include "sunvo/frontend/stereo_frontend.hpp"
+#include "sunvo/selfcal/stereo_self_calibration.hpp"
 #include "sunvo/vo/stereo_track_odometry.hpp"
 
 namespace sunvo::pipeline {
@@ -49,6 +50,9 @@ struct PipelineOptions {
   bool rotation_hint = true;   // centre the front end's un-predicted temporal search on the image
                                //   shift of the last measured rotation (see the header comment)
   double max_hint_px = 100.0;  // px, [0, 1000]: a larger predicted shift is not used as a hint
+  // Online stereo self-calibration of the right camera between the front end and the back end
+  // (estimator/selfcal); enabled needs frontend.measure_v_right (the right rows it learns from).
+  selfcal::StereoSelfCalibrationOptions self_calibration;
 
   // The error names the bad key as the config names it, relative to the options ("frontend.x",
   // "window.x", "ransac.x", "max_hint_px"); the rover prefixes "estimator.".
@@ -60,6 +64,7 @@ struct PipelineOptions {
     vo::VoOptions::fields(s.vo, v);
     v("rotation_hint", s.rotation_hint);
     v("max_hint_px", s.max_hint_px);
+    v("self_calibration", s.self_calibration);
   }
 };
 
@@ -94,6 +99,7 @@ struct FrameResult {
   // without a counter.
   std::uint64_t frontend_counter_delta = 0;
   std::uint64_t odometry_counter_delta = 0;
+  selfcal::SelfCalibrationReport self_calibration;  // this frame's estimate (if enabled)
 };
 
 class StereoImageOdometry {
@@ -131,6 +137,8 @@ class StereoImageOdometry {
   StereoFrontend frontend_;
   vo::StereoTrackOdometry odometry_;
   FrameFeatures features_;
+  selfcal::StereoSelfCalibration self_calibration_;
+  FrameFeatures corrected_;  // features_ with the self-calibration's corrections
   StageCounter counter_ = nullptr;
   bool initialized_ = false;
   bool have_motion_ = false;  // last_motion_ was measured on the previous frame
