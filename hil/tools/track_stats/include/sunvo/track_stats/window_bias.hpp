@@ -1,0 +1,66 @@
+#pragma once
+// Where a two-frame stereo window's rotation error comes from, frame by frame, measured at the
+// ground-truth motion (issue 15: the roll of one-sided frames).
+//
+// For each pair (k-1, k) the window's problem is built as BundleWindow builds it: base b = k-1
+// (fixed), unknowns xi = (phi, dt) of T_k_b (left perturbation in camera k:
+// C_k_b = exp(phi) C_gt, t_k_b = t_gt + dt) and the landmarks p_b seen in both frames, residuals
+// e = y_hat - y of (u, v, d) in both frames whitened by (sigma_u, sigma_v, sigma_d). The poses are
+// held at the truth, every landmark is moved to its own optimum (3 Gauss-Newton steps), pairs with
+// any residual over max_residual_px are dropped (the RANSAC inlier test) and the rest weighted by
+// the Cauchy loss (IRLS weight 1 / (1 + (r / s)^2)). With the landmarks eliminated (Schur
+// complement S of the pose block), one Gauss-Newton step from the truth is
+//   dxi = -S^-1 sum_l (J_p^T W e - H_pl H_ll^-1 J_l^T W e),
+// linear in e: the first-order error the window makes on this frame. It is split by which
+// measurement carries e (the u, v or d rows) and evaluated for hypothetical error fields added to
+// exact measurements (a constant vL shift in frame k, a vL shift c / z_k in frame k, a disparity
+// bias in both frames), which shows how each maps into roll. sqrt(diag(S^-1)) is the window's
+// marginal standard deviation per rotation axis for 1 px noise.
+//
+// Rotation errors are reported as track_stats does: the rotation vector of
+// C_km1_k,true^T C_km1_k,est in camera k, i.e. -phi.
+
+#include <vector>
+
+#include "sunvo/core/camera.hpp"
+#include "sunvo/core/features.hpp"
+#include "sunvo/core/geometry.hpp"
+#include "sunvo/core/status.hpp"
+
+namespace sunvo::track_stats {
+
+struct WindowBiasOptions {
+  double sigma_u_px = 1.0;        // px, > 0: as window.sigma_u_px
+  double sigma_v_px = 1.0;        // px, > 0
+  double sigma_d_px = 1.0;        // px, > 0
+  double loss_scale = 2.0;        // whitened units, > 0: Cauchy scale (window.loss_scale)
+  double min_disparity_px = 1.0;  // px, > 0: triangulation in k-1 needs this disparity
+  double max_residual_px = 5.0;   // px, > 0: a pair with a larger residual is an outlier
+  double inject_v_px = -0.127;    // px: constant vL shift of frame k (hypothesis 1)
+  double inject_v_z_pxm = -3.6;   // px m: vL shift c / z_k of frame k (hypothesis 2)
+  double inject_d_px = -0.3;      // px: disparity bias of both frames (hypothesis 3)
+
+  Status validate() const;
+};
+
+struct FrameWindowBias {
+  int landmarks = 0;  // pairs used
+  // One-step rotation error from the truth [mdeg], camera k (x pitch, y yaw, z roll).
+  Eigen::Vector3d total = Eigen::Vector3d::Zero();
+  Eigen::Vector3d from_u = Eigen::Vector3d::Zero();      // of it, the u rows
+  Eigen::Vector3d from_v = Eigen::Vector3d::Zero();      // the v rows
+  Eigen::Vector3d from_d = Eigen::Vector3d::Zero();      // the d rows
+  Eigen::Vector3d inject_v = Eigen::Vector3d::Zero();    // hypothesis 1 alone
+  Eigen::Vector3d inject_v_z = Eigen::Vector3d::Zero();  // hypothesis 2 alone
+  Eigen::Vector3d inject_d = Eigen::Vector3d::Zero();    // hypothesis 3 alone
+  Eigen::Vector3d sigma_mdeg = Eigen::Vector3d::Zero();  // marginal std per axis, 1 px noise
+  Eigen::Matrix<double, 6, 6> S = Eigen::Matrix<double, 6, 6>::Zero();  // reduced information
+};
+
+// One entry per frame (frame 0 and frames with fewer than 3 pairs: landmarks = 0, zeros).
+Expected<std::vector<FrameWindowBias>> computeWindowBias(const StereoCamera& camera,
+                                                         const std::vector<FrameFeatures>& frames,
+                                                         const std::vector<Isometry3>& gt_T_0_k,
+                                                         const WindowBiasOptions& options);
+
+}  // namespace sunvo::track_stats
