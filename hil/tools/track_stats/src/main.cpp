@@ -39,8 +39,14 @@ bool oneSided(const FrameStats& f) {
 
 // The window's first-order rotation error at the true motion, summed over the one-sided frames
 // and the others (window_bias.hpp), and how well it predicts the estimate's per-frame roll error.
-void printWindowBias(const std::vector<sunvo::track_stats::FrameWindowBias>& wb,
-                     const std::vector<FrameStats>& fs, bool have_estimate) {
+void printWindowBias(const sunvo::track_stats::WindowBias& bias, const std::vector<FrameStats>& fs,
+                     bool have_estimate) {
+  const auto& wb = bias.frames;
+  std::printf("\nmotion residual under the true motion by uL column in k-1 (du / dv px, pairs):\n");
+  for (const auto& c : bias.columns) {
+    std::printf("  u %4.0f-%4.0f: %+.3f / %+.3f (%zu)\n", c.u_min, c.u_max, c.mean_du, c.mean_dv,
+                c.n);
+  }
   using sunvo::track_stats::FrameWindowBias;
   using V = Eigen::Vector3d;
   struct Term {
@@ -63,6 +69,23 @@ void printWindowBias(const std::vector<sunvo::track_stats::FrameWindowBias>& wb,
     for (std::size_t k = 1; k < wb.size(); ++k) (oneSided(fs[k]) ? one : bal) += wb[k].*t.field;
     std::printf("  %-31s %+7.2f %+7.2f %+7.2f    %+7.2f %+7.2f %+7.2f\n", t.name, one.x() * 1e-3,
                 one.y() * 1e-3, one.z() * 1e-3, bal.x() * 1e-3, bal.y() * 1e-3, bal.z() * 1e-3);
+  }
+  {
+    double pr = 0.0, pl = 0.0, er = 0.0, el = 0.0;
+    int nr = 0, nl = 0;
+    for (std::size_t k = 1; k < wb.size(); ++k) {
+      if (!oneSided(fs[k])) continue;
+      const bool right = fs[k].left_share < 0.15;
+      (right ? pr : pl) += wb[k].total.z();
+      (right ? er : el) += fs[k].rot_err_c_mdeg.z();
+      ++(right ? nr : nl);
+    }
+    std::printf(
+        "  roll, all residuals: tracks right of cu (%d frames) %+.2f deg, left of cu (%d) %+.2f "
+        "deg",
+        nr, pr * 1e-3, nl, pl * 1e-3);
+    if (have_estimate) std::printf("; the estimate's: %+.2f and %+.2f deg", er * 1e-3, el * 1e-3);
+    std::printf("\n");
   }
   std::vector<double> s_one, s_bal;
   for (std::size_t k = 1; k < wb.size(); ++k) {
@@ -275,8 +298,8 @@ int main(int argc, char** argv) {
           "frame,landmarks,left_share,total_x,total_y,total_z,u_z,v_z,d_z,inject_v_z,"
           "inject_vz_z,inject_d_z,sigma_x,sigma_y,sigma_z,est_x,est_y,est_z\n";
       char line[512];
-      for (std::size_t k = 0; k < wb->size(); ++k) {
-        const auto& w = (*wb)[k];
+      for (std::size_t k = 0; k < wb->frames.size(); ++k) {
+        const auto& w = wb->frames[k];
         const FrameStats& f = stats->frames[k];
         std::snprintf(line, sizeof(line),
                       "%zu,%d,%.4f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,"

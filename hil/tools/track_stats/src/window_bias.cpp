@@ -1,6 +1,7 @@
 #include "sunvo/track_stats/window_bias.hpp"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <unordered_map>
 
@@ -60,10 +61,10 @@ Status WindowBiasOptions::validate() const {
   return Status::ok();
 }
 
-Expected<std::vector<FrameWindowBias>> computeWindowBias(const StereoCamera& cam,
-                                                         const std::vector<FrameFeatures>& frames,
-                                                         const std::vector<Isometry3>& gt_T_0_k,
-                                                         const WindowBiasOptions& opt) {
+Expected<WindowBias> computeWindowBias(const StereoCamera& cam,
+                                       const std::vector<FrameFeatures>& frames,
+                                       const std::vector<Isometry3>& gt_T_0_k,
+                                       const WindowBiasOptions& opt) {
   SUNVO_RETURN_IF_ERROR(opt.validate());
   SUNVO_RETURN_IF_ERROR(cam.validate());
   if (gt_T_0_k.size() < frames.size()) {
@@ -71,7 +72,15 @@ Expected<std::vector<FrameWindowBias>> computeWindowBias(const StereoCamera& cam
   }
   const Vec3 sigma(opt.sigma_u_px, opt.sigma_v_px, opt.sigma_d_px);
   const Vec3 info = sigma.cwiseInverse().cwiseAbs2();
-  std::vector<FrameWindowBias> out(frames.size());
+  WindowBias result;
+  std::vector<FrameWindowBias>& out = result.frames;
+  out.resize(frames.size());
+  constexpr int kColumns = 8;
+  result.columns.resize(kColumns);
+  for (int c = 0; c < kColumns; ++c) {
+    result.columns[static_cast<std::size_t>(c)].u_min = cam.width * c / double(kColumns);
+    result.columns[static_cast<std::size_t>(c)].u_max = cam.width * (c + 1) / double(kColumns);
+  }
   std::unordered_map<std::int64_t, const StereoObservation*> prev;
   std::vector<PairSystem> pairs;
   std::vector<std::array<Vec3, 2>> errors;
@@ -95,6 +104,19 @@ Expected<std::vector<FrameWindowBias>> computeWindowBias(const StereoCamera& cam
           p_b = T_k_b.inverse() * cam.triangulate(y1.x(), y1.y(), y1.z());
         } else {
           continue;
+        }
+        if (y0.z() >= opt.min_disparity_px) {
+          const Vec3 p_k = C * p_b + t;
+          const Vec3 r = y1 - cam.project(p_k);
+          if (p_k.z() > 1e-3 && std::abs(r.x()) <= opt.max_residual_px &&
+              std::abs(r.y()) <= opt.max_residual_px) {
+            const int c =
+                std::clamp(static_cast<int>(y0.x() / cam.width * kColumns), 0, kColumns - 1);
+            ColumnBin& bin = result.columns[static_cast<std::size_t>(c)];
+            ++bin.n;
+            bin.mean_du += r.x();
+            bin.mean_dv += r.y();
+          }
         }
         // The landmark's own optimum with the poses at the truth.
         bool ok = true;
@@ -188,7 +210,12 @@ Expected<std::vector<FrameWindowBias>> computeWindowBias(const StereoCamera& cam
     prev.clear();
     for (const StereoObservation& o : frames[k].observations) prev[o.landmark_id] = &o;
   }
-  return out;
+  for (ColumnBin& bin : result.columns) {
+    if (bin.n == 0) continue;
+    bin.mean_du /= static_cast<double>(bin.n);
+    bin.mean_dv /= static_cast<double>(bin.n);
+  }
+  return result;
 }
 
 }  // namespace sunvo::track_stats

@@ -57,10 +57,23 @@ struct FrameWindowBias {
   Eigen::Matrix<double, 6, 6> S = Eigen::Matrix<double, 6, 6>::Zero();  // reduced information
 };
 
-// One entry per frame (frame 0 and frames with fewer than 3 pairs: landmarks = 0, zeros).
-Expected<std::vector<FrameWindowBias>> computeWindowBias(const StereoCamera& camera,
-                                                         const std::vector<FrameFeatures>& frames,
-                                                         const std::vector<Isometry3>& gt_T_0_k,
-                                                         const WindowBiasOptions& options);
+// Motion residual (observed - predicted: triangulated in k-1 from its stereo pair, moved by the
+// true motion, projected into k) of the pairs whose uL in k-1 falls in [u_min, u_max): the
+// image-position dependence that a two-frame window reads as roll when all tracks are on one side.
+struct ColumnBin {
+  double u_min = 0.0, u_max = 0.0;  // px
+  std::size_t n = 0;
+  double mean_du = 0.0, mean_dv = 0.0;  // px
+};
+
+struct WindowBias {
+  std::vector<FrameWindowBias> frames;  // one per frame (frame 0 and frames with < 3 pairs: zeros)
+  std::vector<ColumnBin> columns;       // 8 columns over the image width
+};
+
+Expected<WindowBias> computeWindowBias(const StereoCamera& camera,
+                                       const std::vector<FrameFeatures>& frames,
+                                       const std::vector<Isometry3>& gt_T_0_k,
+                                       const WindowBiasOptions& options);
 
 }  // namespace sunvo::track_stats
