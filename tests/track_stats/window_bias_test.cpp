@@ -57,6 +57,8 @@ TEST(WindowBias, ExactTracksGiveNoErrorAndTheInjectedFieldsMapAsExpected) {
     EXPECT_GT(f.sigma_mdeg.z(), 0.0) << k;
   }
   EXPECT_GT(used, 15);
+  EXPECT_NEAR(wb->fit_k1, 0.0, 1e-9);
+  EXPECT_NEAR(wb->rms_before_px, 0.0, 1e-9);
   for (const ColumnBin& c : wb->columns) {
     if (c.n > 0) {
       EXPECT_NEAR(c.mean_du, 0.0, 1e-6);
@@ -99,6 +101,35 @@ TEST(WindowBias, AnImageRollIsReportedAsRoll) {
   EXPECT_NEAR(wb->frames[1].total.z(), -roll_mdeg, 0.05 * roll_mdeg);
   EXPECT_NEAR((wb->frames[1].from_u + wb->frames[1].from_v + wb->frames[1].from_d).z(),
               wb->frames[1].total.z(), 1e-9);
+}
+
+// Tracks seen through a radial distortion k1 = 0.02 in both images: the fit finds it.
+TEST(WindowBias, FitsARadialDistortionOfTheTracks) {
+  const auto T_0_k = straightDrive(40);
+  auto frames = cleanTracks(T_0_k);
+  const StereoCamera cam = kittiCamera();
+  const double k1 = 0.02;
+  auto distort = [&](double& u, double v) {
+    const double x = (u - cam.cu) / cam.fu, y = (v - cam.cv) / cam.fv;
+    u += cam.fu * k1 * (x * x + y * y) * x;
+  };
+  for (FrameFeatures& f : frames) {
+    for (StereoObservation& o : f.observations) {
+      const double x = (o.u_left - cam.cu) / cam.fu, y = (o.v_left - cam.cv) / cam.fv;
+      const double v_shift = cam.fv * k1 * (x * x + y * y) * y;
+      distort(o.u_left, o.v_left);
+      distort(o.u_right, o.v_right);
+      o.v_left += v_shift;
+      o.v_right += v_shift;
+    }
+  }
+  auto wb = computeWindowBias(cam, frames, T_0_k, WindowBiasOptions{});
+  ASSERT_TRUE(wb) << wb.status().toString();
+  std::printf("fitted k1 %.5f (true %.5f), rms %.4f -> %.4f px\n", wb->fit_k1, k1,
+              wb->rms_before_px, wb->rms_after_px);
+  EXPECT_NEAR(wb->fit_k1, k1, 0.2 * k1);
+  EXPECT_LT(wb->rms_after_px, 0.5 * wb->rms_before_px);
+  EXPECT_EQ(wb->k1_used, wb->fit_k1);
 }
 
 TEST(WindowBias, OptionsAndInputsAreChecked) {

@@ -42,6 +42,13 @@ bool oneSided(const FrameStats& f) {
 void printWindowBias(const sunvo::track_stats::WindowBias& bias, const std::vector<FrameStats>& fs,
                      bool have_estimate) {
   const auto& wb = bias.frames;
+  std::printf(
+      "\nmotion residuals as a radial distortion of every image + a + c/z per axis: k1 %+.5f, a_u "
+      "%+.3f "
+      "px, c_u %+.3f px m, a_v %+.3f px, c_v %+.3f px m; rms %.4f -> %.4f px; injected k1 "
+      "%+.5f\n",
+      bias.fit_k1, bias.fit_a_u_px, bias.fit_c_u_pxm, bias.fit_a_v_px, bias.fit_c_v_pxm,
+      bias.rms_before_px, bias.rms_after_px, bias.k1_used);
   std::printf("\nmotion residual under the true motion by uL column in k-1 (du / dv px, pairs):\n");
   for (const auto& c : bias.columns) {
     std::printf("  u %4.0f-%4.0f: %+.3f / %+.3f (%zu)\n", c.u_min, c.u_max, c.mean_du, c.mean_dv,
@@ -59,7 +66,8 @@ void printWindowBias(const sunvo::track_stats::WindowBias& bias, const std::vect
                         {"  of it d rows", &FrameWindowBias::from_d},
                         {"injected vL shift alone", &FrameWindowBias::inject_v},
                         {"injected vL shift c/z alone", &FrameWindowBias::inject_v_z},
-                        {"injected disparity bias alone", &FrameWindowBias::inject_d}};
+                        {"injected disparity bias alone", &FrameWindowBias::inject_d},
+                        {"injected radial distortion alone", &FrameWindowBias::inject_k1}};
   std::printf(
       "\nwindow at the true motion (window_bias.hpp): one-step rotation error summed, deg "
       "(x pitch, y yaw, z roll)\n  %-31s %-26s %-26s\n",
@@ -151,6 +159,8 @@ int main(int argc, char** argv) {
   app.add_option("--inject-v-px", wbo.inject_v_px, "injected constant vL shift, px");
   app.add_option("--inject-v-z-pxm", wbo.inject_v_z_pxm, "injected vL shift c / z, px m");
   app.add_option("--inject-d-px", wbo.inject_d_px, "injected disparity bias, px");
+  app.add_option("--inject-k1", wbo.inject_k1,
+                 "injected radial distortion k1 (0 = the one fitted to the motion residuals)");
   if (auto code = sunvo::cli::parse(app, argc, argv)) return *code;
 
   sunvo::files::TrackReadOptions tro;

@@ -37,7 +37,17 @@ struct PairSystem {
   Mat3 Hll_inv;
   Eigen::Matrix<double, 6, 3> Hpl;
   double z_k = 0.0;
+  Vec3 y0, y1;  // the exact observations a distortion would move: predicted from p_b
 };
+
+// Pixel displacement of (u, v) and of the right image's u by a radial distortion with k1 = 1.
+Vec3 distortion(const StereoCamera& cam, const Vec3& y) {
+  const double x = (y.x() - cam.cu) / cam.fu, v = (y.y() - cam.cv) / cam.fv;
+  const double xr = (y.x() - y.z() - cam.cu) / cam.fu;
+  const double r2 = x * x + v * v, r2r = xr * xr + v * v;
+  const double du = cam.fu * r2 * x, dur = cam.fu * r2r * xr;
+  return {du, cam.fv * r2 * v, du - dur};  // (u, v, d)
+}
 
 // b = J_p^T W e - H_pl H_ll^-1 J_l^T W e for errors e0 (frame b), e1 (frame k).
 Vec6 reducedGradient(const PairSystem& s, const Vec3& e0, const Vec3& e1) {
@@ -55,7 +65,7 @@ Status WindowBiasOptions::validate() const {
   if (!(min_disparity_px > 0.0)) return invalidArgument("window bias: min_disparity_px > 0");
   if (!(max_residual_px > 0.0)) return invalidArgument("window bias: max_residual_px > 0");
   if (!std::isfinite(inject_v_px) || !std::isfinite(inject_v_z_pxm) ||
-      !std::isfinite(inject_d_px)) {
+      !std::isfinite(inject_d_px) || !std::isfinite(inject_k1)) {
     return invalidArgument("window bias: injected errors must be finite");
   }
   return Status::ok();
@@ -81,6 +91,10 @@ Expected<WindowBias> computeWindowBias(const StereoCamera& cam,
     result.columns[static_cast<std::size_t>(c)].u_min = cam.width * c / double(kColumns);
     result.columns[static_cast<std::size_t>(c)].u_max = cam.width * (c + 1) / double(kColumns);
   }
+  Eigen::Matrix<double, 5, 5> fit_A = Eigen::Matrix<double, 5, 5>::Zero();
+  Eigen::Matrix<double, 5, 1> fit_b = Eigen::Matrix<double, 5, 1>::Zero();
+  double fit_ee = 0.0;
+  std::size_t fit_n = 0;
   std::unordered_map<std::int64_t, const StereoObservation*> prev;
   std::vector<PairSystem> pairs;
   std::vector<std::array<Vec3, 2>> errors;
@@ -116,6 +130,22 @@ Expected<WindowBias> computeWindowBias(const StereoCamera& cam,
             ++bin.n;
             bin.mean_du += r.x();
             bin.mean_dv += r.y();
+            // The residual's change with k1: D moves y1 directly and y0 through the
+            // triangulation and the motion, y0 -> project(C tri(y0) + t):
+            // d tri / d(u, v, d) = [(z / fu, 0, 0), (0, z / fv, 0), -p / d] (columns).
+            Mat3 tri_jac = Mat3::Zero();
+            tri_jac(0, 0) = p_b.z() / cam.fu;
+            tri_jac(1, 1) = p_b.z() / cam.fv;
+            tri_jac.col(2) = -p_b / y0.z();
+            const Vec3 g = distortion(cam, cam.project(p_k)) -
+                           projectionJacobian(cam, p_k) * C * tri_jac * distortion(cam, y0);
+            Eigen::Matrix<double, 5, 1> xu, xv;
+            xu << g.x(), 1.0, 1.0 / p_k.z(), 0.0, 0.0;
+            xv << g.y(), 0.0, 0.0, 1.0, 1.0 / p_k.z();
+            fit_A += xu * xu.transpose() + xv * xv.transpose();
+            fit_b += xu * r.x() + xv * r.y();
+            fit_ee += r.x() * r.x() + r.y() * r.y();
+            ++fit_n;
           }
         }
         // The landmark's own optimum with the poses at the truth.
@@ -159,6 +189,8 @@ Expected<WindowBias> computeWindowBias(const StereoCamera& cam,
         s.Hll_inv = Hll.inverse();
         s.Hpl = s.Jp1.transpose() * s.W1.asDiagonal() * s.Jl1;
         s.z_k = p_k.z();
+        s.y0 = cam.project(p_b);
+        s.y1 = cam.project(p_k);
         if (!s.Hll_inv.allFinite()) continue;
         pairs.push_back(s);
         errors.push_back({e0, e1});
@@ -167,7 +199,7 @@ Expected<WindowBias> computeWindowBias(const StereoCamera& cam,
       if (pairs.size() >= 3) {
         Eigen::Matrix<double, 6, 6> S = Eigen::Matrix<double, 6, 6>::Zero();
         Vec6 b_total = Vec6::Zero(), b_u = Vec6::Zero(), b_v = Vec6::Zero(), b_d = Vec6::Zero();
-        Vec6 b_iv = Vec6::Zero(), b_ivz = Vec6::Zero(), b_id = Vec6::Zero();
+        Vec6 b_iv = Vec6::Zero(), b_ivz = Vec6::Zero(), b_id = Vec6::Zero(), b_ik = Vec6::Zero();
         for (std::size_t i = 0; i < pairs.size(); ++i) {
           const PairSystem& s = pairs[i];
           S +=
@@ -187,6 +219,8 @@ Expected<WindowBias> computeWindowBias(const StereoCamera& cam,
           b_ivz += reducedGradient(s, Vec3::Zero(), Vec3(0.0, -opt.inject_v_z_pxm / s.z_k, 0.0));
           b_id += reducedGradient(s, Vec3(0.0, 0.0, -opt.inject_d_px),
                                   Vec3(0.0, 0.0, -opt.inject_d_px));
+          // Radial distortion with k1 = 1 in both images (scaled by the k1 used at the end).
+          b_ik += reducedGradient(s, -distortion(cam, s.y0), -distortion(cam, s.y1));
         }
         const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt(S);
         const Eigen::Matrix<double, 6, 6> S_inv =
@@ -202,6 +236,7 @@ Expected<WindowBias> computeWindowBias(const StereoCamera& cam,
           f.inject_v = rot(b_iv);
           f.inject_v_z = rot(b_ivz);
           f.inject_d = rot(b_id);
+          f.inject_k1 = rot(b_ik);
           for (int a = 0; a < 3; ++a) f.sigma_mdeg[a] = std::sqrt(S_inv(a, a)) * kRadToMdeg;
           f.S = S;
         }
@@ -210,6 +245,22 @@ Expected<WindowBias> computeWindowBias(const StereoCamera& cam,
     prev.clear();
     for (const StereoObservation& o : frames[k].observations) prev[o.landmark_id] = &o;
   }
+  if (fit_n > 5) {
+    const Eigen::Matrix<double, 5, 1> x = fit_A.ldlt().solve(fit_b);
+    if (x.allFinite()) {
+      result.fit_k1 = x[0];
+      result.fit_a_u_px = x[1];
+      result.fit_c_u_pxm = x[2];
+      result.fit_a_v_px = x[3];
+      result.fit_c_v_pxm = x[4];
+      // sum (r - X x)^2 = r.r - 2 x.b + x.A x
+      const double ss = fit_ee - 2.0 * x.dot(fit_b) + x.dot(fit_A * x);
+      result.rms_before_px = std::sqrt(fit_ee / (2.0 * static_cast<double>(fit_n)));
+      result.rms_after_px = std::sqrt(std::max(0.0, ss) / (2.0 * static_cast<double>(fit_n)));
+    }
+  }
+  result.k1_used = opt.inject_k1 != 0.0 ? opt.inject_k1 : result.fit_k1;
+  for (FrameWindowBias& f : out) f.inject_k1 *= result.k1_used;
   for (ColumnBin& bin : result.columns) {
     if (bin.n == 0) continue;
     bin.mean_du /= static_cast<double>(bin.n);

@@ -39,6 +39,9 @@ struct WindowBiasOptions {
   double inject_v_px = -0.127;    // px: constant vL shift of frame k (hypothesis 1)
   double inject_v_z_pxm = -3.6;   // px m: vL shift c / z_k of frame k (hypothesis 2)
   double inject_d_px = -0.3;      // px: disparity bias of both frames (hypothesis 3)
+  double inject_k1 = 0.0;  // 1, finite: radial distortion left in every image (hypothesis 4),
+                           // (u, v) += (fu x, fv y) k1 (x^2 + y^2), x = (u - cu) / fu, y alike;
+                           // 0 = the k1 fitted to the motion residuals (WindowBias::fit_k1)
 
   Status validate() const;
 };
@@ -53,6 +56,7 @@ struct FrameWindowBias {
   Eigen::Vector3d inject_v = Eigen::Vector3d::Zero();    // hypothesis 1 alone
   Eigen::Vector3d inject_v_z = Eigen::Vector3d::Zero();  // hypothesis 2 alone
   Eigen::Vector3d inject_d = Eigen::Vector3d::Zero();    // hypothesis 3 alone
+  Eigen::Vector3d inject_k1 = Eigen::Vector3d::Zero();   // hypothesis 4 alone
   Eigen::Vector3d sigma_mdeg = Eigen::Vector3d::Zero();  // marginal std per axis, 1 px noise
   Eigen::Matrix<double, 6, 6> S = Eigen::Matrix<double, 6, 6>::Zero();  // reduced information
 };
@@ -69,6 +73,14 @@ struct ColumnBin {
 struct WindowBias {
   std::vector<FrameWindowBias> frames;  // one per frame (frame 0 and frames with < 3 pairs: zeros)
   std::vector<ColumnBin> columns;       // 8 columns over the image width
+  // Least-squares fit of the motion residuals (those of the columns) as a radial distortion D
+  // of every image (left u, v and right u) plus a shift a + c / z per axis:
+  //   r = k1 (D(y1) - M D(y0)) + (a_u + c_u / z, a_v + c_v / z),
+  // M = d project(C tri(y0) + t) / d y0 (the distorted y0 moves the triangulated point).
+  double fit_k1 = 0.0;
+  double fit_a_u_px = 0.0, fit_c_u_pxm = 0.0, fit_a_v_px = 0.0, fit_c_v_pxm = 0.0;
+  double rms_before_px = 0.0, rms_after_px = 0.0;  // of the residuals, per component
+  double k1_used = 0.0;                            // the k1 of hypothesis 4
 };
 
 Expected<WindowBias> computeWindowBias(const StereoCamera& camera,
