@@ -98,6 +98,8 @@ Status BundleWindow::init(const WindowOptions& options, const StereoCamera& came
   yaw_axis_c_ = Eigen::Vector3d::UnitY();
   const double w0 = options.yaw_axis_prior_deg * M_PI / 180.0;
   yaw_scatter_ = w0 * w0 * yaw_axis_c_ * yaw_axis_c_.transpose();
+  saved_yaw_scatter_ = yaw_scatter_;
+  saved_yaw_axis_c_ = yaw_axis_c_;
   num_residuals_ = 0;
 
   switch (options.loss) {
@@ -420,6 +422,8 @@ Expected<WindowSolveSummary> BundleWindow::solve() {
   if (options_.rotation_rate_prior) SUNVO_RETURN_IF_ERROR(addRatePriors(out, use_ceres));
 
   saved_poses_ = poses_;
+  saved_yaw_scatter_ = yaw_scatter_;
+  saved_yaw_axis_c_ = yaw_axis_c_;
   if (hook_) {
     in_hook_ = true;
     const Status s = hook_(*this);

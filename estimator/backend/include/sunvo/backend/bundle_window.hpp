@@ -161,8 +161,12 @@ class BundleWindow {
   Expected<WindowSolveSummary> solve();
 
   // Puts every pose back to the initial guess it had before the last solve() (e.g. when the
-  // caller rejects the solution).
-  void restoreInitialGuess() { poses_ = saved_poses_; }
+  // caller rejects the solution), and the yaw-axis estimate to what it was before that solve.
+  void restoreInitialGuess() {
+    poses_ = saved_poses_;
+    yaw_scatter_ = saved_yaw_scatter_;
+    yaw_axis_c_ = saved_yaw_axis_c_;
+  }
 
   int size() const { return size_; }
   const Isometry3& T_w_b() const { return T_w_b_; }
@@ -263,6 +267,8 @@ class BundleWindow {
   bool in_hook_ = false;
   Eigen::Matrix3d yaw_scatter_ = Eigen::Matrix3d::Zero();  // rad^2, sum of phi phi^T (forgotten)
   Eigen::Vector3d yaw_axis_c_ = Eigen::Vector3d::UnitY();
+  Eigen::Matrix3d saved_yaw_scatter_ = Eigen::Matrix3d::Zero();  // before the last solve
+  Eigen::Vector3d saved_yaw_axis_c_ = Eigen::Vector3d::UnitY();
   int num_extra_ = 0;
 };
 
