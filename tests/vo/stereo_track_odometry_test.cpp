@@ -193,7 +193,7 @@ TEST(VoOptions, ValidateNamesTheBadKey) {
 
 // Replay regression on the first 200 frames of the real 0020 tracks (232 m) with the default
 // options. Measured with the window's rotation-rate prior (default since issue 15):
-// translational ARMSE 1.608 m, final drift 7.229 m, final rotation error 2.737 deg, 3 lost frames
+// translational ARMSE 1.613 m, final drift 7.246 m, final rotation error 2.777 deg, 3 lost frames
 // (frame 1 and the 5-match frames 53-54); without it (window.rotation_rate_prior = false) 2.106 m,
 // 10.19 m, 6.09 deg. Bounds are the measurement plus about 20 %.
 TEST(StereoTrackOdometry, ReplayRegressionOnReal0020Tracks) {
@@ -224,7 +224,7 @@ TEST(StereoTrackOdometry, ReplayRegressionOnReal0020Tracks) {
       armse, drift, rot, lost);
   EXPECT_LT(armse, 1.95);
   EXPECT_LT(drift, 8.7);
-  EXPECT_LT(rot, 3.3);
+  EXPECT_LT(rot, 3.35);
   EXPECT_LE(lost, 3);
 }
 

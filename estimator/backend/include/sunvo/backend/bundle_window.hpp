@@ -85,8 +85,12 @@ struct WindowOptions {
   double rate_prior_pitch_deg_s = 2.0;  // deg/s, [0, 1000]: 0 = no prior on pitch
   double rate_prior_yaw_deg_s = 0.0;    // deg/s, [0, 1000]: 0 = none (turns are the motion)
   double rate_prior_roll_deg_s = 2.0;   // deg/s, [0, 1000]: 0 = no prior on roll
-  double yaw_axis_memory_s = 120.0;     // s, (0, 1e6]: time constant of the yaw-axis estimate
-  double yaw_axis_prior_deg = 1.0;  // deg, (0, 180]: turning the camera's y axis counts as in the
+  // Yaw-axis estimate: memory tau spans a few turns of urban driving; the regulariser outweighs
+  // what the body-rate wobble adds over tau on a straight road ((rate std x dt)^2 x tau / dt =
+  // (0.2 deg)^2 x 200 frames = 8 deg^2 at 2 deg/s and 10 Hz < 9 deg^2), so a long straight
+  // cannot tilt the axis, while one frame of a 3 deg/frame turn already weighs 9 deg^2.
+  double yaw_axis_memory_s = 20.0;  // s, (0, 1e6]: time constant of the yaw-axis estimate
+  double yaw_axis_prior_deg = 3.0;  // deg, (0, 180]: turning the camera's y axis counts as in the
                                     // yaw-axis estimate (its weight against observed turns)
 
   Status validate() const;
