@@ -474,8 +474,10 @@ Status BundleWindow::addRatePriors(WindowSolveSummary& out, bool use_ceres) {
   const Eigen::Vector3d rows[3] = {e1, a, e2};
   for (int s = 1; s < size_; ++s) {
     const auto us = static_cast<std::size_t>(s);
-    const double dt_s = static_cast<double>(frames_[us].time_ns - frames_[us - 1].time_ns) * 1e-9;
+    double dt_s = static_cast<double>(frames_[us].time_ns - frames_[us - 1].time_ns) * 1e-9;
     if (!(dt_s > 0.0) || !std::isfinite(dt_s)) continue;
+    // A glitching time stamp (frames < 1 ms apart) must not make the prior rigid.
+    dt_s = std::max(dt_s, 1e-3);
     RotationRatePriorData& d = frames_[us].rate_prior;
     for (int i = 0; i < 3; ++i) {
       d.sqrt_info[i] = rates[i] > 0.0 ? 1.0 / (rates[i] * dt_s) : 0.0;

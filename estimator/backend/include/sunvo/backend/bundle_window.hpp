@@ -74,7 +74,7 @@ struct WindowOptions {
   // Zero-mean prior on each window frame's rotation relative to the previous window frame
   // (issue 15; RotationRatePriorResidual) along the pitch-like and roll-like directions
   // orthogonal to the vehicle's yaw axis: std = rate std x dt, dt from the frame times (no prior
-  // when dt <= 0). A ground vehicle's roll and pitch stay bounded; typical passenger-car body
+  // when dt <= 0, dt taken as at least 1 ms). A ground vehicle's roll and pitch stay bounded; typical passenger-car body
   // rates in normal driving are a few deg/s (roll gradient 3-6 deg/g with lateral jerk < 0.5 g/s;
   // body modes at 1-1.5 Hz of 0.2-0.5 deg). It matters only on an axis the tracks constrain
   // weakly (tracks on one side of the image leave roll weak). The yaw axis in the camera frame
