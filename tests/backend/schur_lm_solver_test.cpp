@@ -136,6 +136,8 @@ Result run(const Scenario& sc, WindowSolver solver, int frames = 6) {
     auto s = w.solve();
     EXPECT_TRUE(s) << s.status().toString();
     if (!s) break;
+    // The rotation-rate prior (on by default) is part of both solvers' problem.
+    EXPECT_EQ(s->num_rate_prior_residuals, w.size() - 1);
     out.summaries.push_back(*s);
     out.T_w_k.push_back(w.T_w_newest());
     std::copy(delta, delta + 3, out.delta.begin());

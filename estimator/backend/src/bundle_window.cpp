@@ -2,6 +2,7 @@
 
 #include <ceres/solver.h>
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -38,6 +39,19 @@ Status WindowOptions::validate() const {
     return invalidArgument(
         "window.motion_prior_sigma_rot_deg and window.motion_prior_sigma_trans_m must both be > 0 "
         "or both 0");
+  }
+  for (const auto& [key, value] : {std::pair{"rate_prior_pitch_deg_s", rate_prior_pitch_deg_s},
+                                   std::pair{"rate_prior_yaw_deg_s", rate_prior_yaw_deg_s},
+                                   std::pair{"rate_prior_roll_deg_s", rate_prior_roll_deg_s}}) {
+    if (!(value >= 0.0 && value <= 1000.0)) {
+      return invalidArgument(std::string("window.") + key + " must be in [0, 1000]");
+    }
+  }
+  if (!(yaw_axis_memory_s > 0.0 && yaw_axis_memory_s <= 1e6)) {
+    return invalidArgument("window.yaw_axis_memory_s must be in (0, 1e6]");
+  }
+  if (!(yaw_axis_prior_deg > 0.0 && yaw_axis_prior_deg <= 180.0)) {
+    return invalidArgument("window.yaw_axis_prior_deg must be in (0, 180]");
   }
   return Status::ok();
 }
@@ -78,8 +92,14 @@ Status BundleWindow::init(const WindowOptions& options, const StereoCamera& came
   for (std::size_t s = 0; s < frames_.size(); ++s) {
     frames_[s].has_prior = false;
     prior_pool_[s].reset(MotionPriorResidual::Create(&frames_[s].prior));
+    rate_prior_pool_[s].reset(RotationRatePriorResidual::Create(&frames_[s].rate_prior));
   }
-  residual_ids_.assign(n_pool + 9 * kMaxWindowSize, nullptr);
+  residual_ids_.assign(n_pool + 10 * kMaxWindowSize, nullptr);
+  yaw_axis_c_ = Eigen::Vector3d::UnitY();
+  const double w0 = options.yaw_axis_prior_deg * M_PI / 180.0;
+  yaw_scatter_ = w0 * w0 * yaw_axis_c_ * yaw_axis_c_.transpose();
+  saved_yaw_scatter_ = yaw_scatter_;
+  saved_yaw_axis_c_ = yaw_axis_c_;
   num_residuals_ = 0;
 
   switch (options.loss) {
@@ -399,7 +419,11 @@ Expected<WindowSolveSummary> BundleWindow::solve() {
         poses_[us].q.data(), poses_[us].t.data());
   }
 
+  if (options_.rotation_rate_prior) SUNVO_RETURN_IF_ERROR(addRatePriors(out, use_ceres));
+
   saved_poses_ = poses_;
+  saved_yaw_scatter_ = yaw_scatter_;
+  saved_yaw_axis_c_ = yaw_axis_c_;
   if (hook_) {
     in_hook_ = true;
     const Status s = hook_(*this);
@@ -430,8 +454,77 @@ Expected<WindowSolveSummary> BundleWindow::solve() {
   out.initial_cost = summary.initial_cost;
   out.final_cost = summary.final_cost;
   out.converged = summary.termination_type == ceres::CONVERGENCE;
+  updateYawAxis();
   if (post_hook_) post_hook_(*this);
   return out;
+}
+
+// Rotation-rate priors between consecutive slots (RotationRatePriorResidual): basis rows = the
+// pitch-like direction e1 = a x e2, the yaw axis a, the roll-like direction e2 (the optical axis
+// made orthogonal to a); std = rate std x dt per row.
+Status BundleWindow::addRatePriors(WindowSolveSummary& out, bool use_ceres) {
+  constexpr double kDegToRad = M_PI / 180.0;
+  const double rates[3] = {options_.rate_prior_pitch_deg_s * kDegToRad,
+                           options_.rate_prior_yaw_deg_s * kDegToRad,
+                           options_.rate_prior_roll_deg_s * kDegToRad};
+  if (!(rates[0] > 0.0 || rates[1] > 0.0 || rates[2] > 0.0)) return Status::ok();
+  const Eigen::Vector3d& a = yaw_axis_c_;
+  const Eigen::Vector3d e2 = (Eigen::Vector3d::UnitZ() - a.z() * a).normalized();
+  const Eigen::Vector3d e1 = a.cross(e2);
+  const Eigen::Vector3d rows[3] = {e1, a, e2};
+  for (int s = 1; s < size_; ++s) {
+    const auto us = static_cast<std::size_t>(s);
+    double dt_s = static_cast<double>(frames_[us].time_ns - frames_[us - 1].time_ns) * 1e-9;
+    if (!(dt_s > 0.0) || !std::isfinite(dt_s)) continue;
+    // A glitching time stamp (frames < 1 ms apart) must not make the prior rigid.
+    dt_s = std::max(dt_s, 1e-3);
+    RotationRatePriorData& d = frames_[us].rate_prior;
+    for (int i = 0; i < 3; ++i) {
+      d.sqrt_info[i] = rates[i] > 0.0 ? 1.0 / (rates[i] * dt_s) : 0.0;
+      for (int j = 0; j < 3; ++j) d.basis[3 * i + j] = rows[i][j];
+    }
+    ++out.num_rate_prior_residuals;
+    if (!use_ceres) {
+      using Kind = SchurLmSolver::BlockRef::Kind;
+      const SchurLmSolver::BlockRef refs[] = {{Kind::kRotation, s - 1, nullptr},
+                                              {Kind::kRotation, s, nullptr}};
+      SUNVO_RETURN_IF_ERROR(schur_.addGeneric(rate_prior_pool_[us].get(), nullptr, refs));
+      ++num_residuals_;
+      continue;
+    }
+    residual_ids_[static_cast<std::size_t>(num_residuals_++)] = problem_->AddResidualBlock(
+        rate_prior_pool_[us].get(), nullptr, poses_[us - 1].q.data(), poses_[us].q.data());
+  }
+  return Status::ok();
+}
+
+// Yaw axis = principal eigenvector of M = sum_k lambda^(t_now - t_k) phi_k phi_k^T + w0^2 y y^T,
+// phi_k the newest frame's rotation vector relative to the previous window frame (turns
+// dominate M: a 3 deg/frame turn weighs 900 times a 0.1 deg/frame wobble), lambda = exp(-dt / tau).
+// The regulariser w0^2 y y^T is kept at a constant weight, so that without turns the axis
+// returns to the camera's y axis.
+void BundleWindow::updateYawAxis() {
+  if (size_ < 2) return;
+  const auto k = static_cast<std::size_t>(size_ - 1);
+  const double dt_s = static_cast<double>(frames_[k].time_ns - frames_[k - 1].time_ns) * 1e-9;
+  const Isometry3 T_k_km1 = T_k_b(size_ - 1) * T_k_b(size_ - 2).inverse();
+  const Eigen::Vector3d phi = logSO3(T_k_km1.linear());
+  if (!phi.allFinite() || !(dt_s > 0.0) || !std::isfinite(dt_s)) return;
+  const double lambda = std::exp(-dt_s / options_.yaw_axis_memory_s);
+  const double w0 = options_.yaw_axis_prior_deg * M_PI / 180.0;
+  const Eigen::Vector3d y = Eigen::Vector3d::UnitY();
+  yaw_scatter_ =
+      lambda * yaw_scatter_ + phi * phi.transpose() + (1.0 - lambda) * w0 * w0 * y * y.transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(yaw_scatter_);
+  if (eig.info() != Eigen::Success) return;
+  Eigen::Vector3d a = eig.eigenvectors().col(2);  // largest eigenvalue last
+  if (!a.allFinite() || a.norm() < 0.5) return;
+  a.normalize();
+  if (a.y() < 0.0) a = -a;
+  // An axis more than 45 deg from the camera's y axis is not the turn axis of a camera looking
+  // along the direction of travel (e.g. the scatter of a long straight drive without turns):
+  // keep the previous one (this also keeps the roll-like direction well defined).
+  if (a.y() > std::sqrt(0.5)) yaw_axis_c_ = a;
 }
 
 Expected<WindowSolveSummary> BundleWindow::solveSchur(WindowSolveSummary out) {
@@ -449,6 +542,7 @@ Expected<WindowSolveSummary> BundleWindow::solveSchur(WindowSolveSummary out) {
   out.initial_cost = r->initial_cost;
   out.final_cost = r->final_cost;
   out.converged = r->converged;
+  updateYawAxis();
   if (post_hook_) post_hook_(*this);
   return out;
 }

@@ -72,6 +72,17 @@ int main(int argc, char** argv) {
   app.add_option("--prior-rot-deg", win.motion_prior_sigma_rot_deg, "motion prior, deg");
   app.add_option("--prior-trans-m", win.motion_prior_sigma_trans_m, "motion prior, m");
   app.add_option("--seed", opt.seed, "RANSAC seed");
+  app.add_flag("!--no-rate-prior", win.rotation_rate_prior,
+               "no zero-mean rotation-rate prior in the window (window.rotation_rate_prior)");
+  app.add_option("--rate-prior-pitch", win.rate_prior_pitch_deg_s,
+                 "rotation-rate prior std about the camera x axis, deg/s (0 = none)")
+      ->check(CLI::Range(0.0, 1000.0));
+  app.add_option("--rate-prior-yaw", win.rate_prior_yaw_deg_s,
+                 "rotation-rate prior std about the camera y axis, deg/s (0 = none)")
+      ->check(CLI::Range(0.0, 1000.0));
+  app.add_option("--rate-prior-roll", win.rate_prior_roll_deg_s,
+                 "rotation-rate prior std about the optical axis, deg/s (0 = none)")
+      ->check(CLI::Range(0.0, 1000.0));
   app.add_option("--log", args.log_path, "per-frame CSV log");
   sunvo::selfcal::StereoSelfCalibrationOptions selfcal_opt;  // issue 15: off unless --self-calib
   app.add_flag("--self-calib", selfcal_opt.enabled,
@@ -97,12 +108,15 @@ int main(int argc, char** argv) {
   std::printf(
       "options: window %d%s, ransac thr %.2f px iters %d min_inliers %d, sigma u/v/d "
       "%.2f/%.2f/%.2f px, loss %s scale %.2f, solver max_iter %d max_time %.3f s, "
-      "min_disparity %.2f px, motion prior %.3f deg / %.3f m, seed %llu\n",
+      "min_disparity %.2f px, motion prior %.3f deg / %.3f m, rate prior %s (pitch/yaw/roll "
+      "%.2f/%.2f/%.2f deg/s), seed %llu\n",
       win.window_size, opt.use_window ? "" : " (disabled)", opt.ransac.inlier_threshold_px,
       opt.ransac.max_iterations, opt.ransac.min_inliers, win.sigma_u_px, win.sigma_v_px,
       win.sigma_d_px, kLoss[static_cast<int>(win.loss)], win.loss_scale, win.max_num_iterations,
       win.max_solver_time_in_seconds, opt.ransac.min_disparity_px, win.motion_prior_sigma_rot_deg,
-      win.motion_prior_sigma_trans_m, static_cast<unsigned long long>(opt.seed));
+      win.motion_prior_sigma_trans_m, win.rotation_rate_prior ? "on" : "off",
+      win.rate_prior_pitch_deg_s, win.rate_prior_yaw_deg_s, win.rate_prior_roll_deg_s,
+      static_cast<unsigned long long>(opt.seed));
   auto seq = sunvo::dataset::readTrackFolder(args.folder, sunvo::files::TrackReadOptions{});
   if (!seq) return sunvo::cli::fail(kProgram, seq.status());
   std::printf(
@@ -215,6 +229,11 @@ int main(int argc, char** argv) {
     std::printf("timing %-8s ms/frame: median %.3f  p95 %.3f  p99 %.3f  max %.3f\n", name,
                 percentile(v, 50), percentile(v, 95), percentile(v, 99), percentile(v, 100));
   };
+  if (opt.use_window) {
+    const Eigen::Vector3d& a = vo.window().yawAxis();
+    std::printf("yaw axis estimate (camera frame): %+.4f %+.4f %+.4f (%.2f deg from y)\n", a.x(),
+                a.y(), a.z(), std::acos(std::min(1.0, a.y())) * 180.0 / M_PI);
+  }
   timing("total", total_ms);
   timing("ransac", ransac_ms);
   if (opt.use_window) timing("window", window_ms);

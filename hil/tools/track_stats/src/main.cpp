@@ -3,6 +3,7 @@
 // conditioning, the frames where the error jumps); see track_stats.hpp. --help lists the options.
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -11,6 +12,7 @@
 #include "sunvo/dataset/track_folder.hpp"
 #include "sunvo/files/trajectory_io.hpp"
 #include "sunvo/track_stats/track_stats.hpp"
+#include "sunvo/track_stats/window_bias.hpp"
 
 namespace {
 constexpr const char* kProgram = "sunvo_track_stats";
@@ -30,6 +32,90 @@ void printDistribution(const char* name, const std::vector<double>& v, double sc
   m = v.empty() ? 0.0 : m / static_cast<double>(v.size());
   std::printf("  %-34s mean %+.4f  median %+.4f  p5 %+.4f  p95 %+.4f %s\n", name, m * scale,
               quantile(v, 0.5) * scale, quantile(v, 0.05) * scale, quantile(v, 0.95) * scale, unit);
+}
+bool oneSided(const FrameStats& f) {
+  return f.tracks > 0 && (f.left_share < 0.15 || f.left_share > 0.85);
+}
+
+// The window's first-order rotation error at the true motion, summed over the one-sided frames
+// and the others (window_bias.hpp), and how well it predicts the estimate's per-frame roll error.
+void printWindowBias(const sunvo::track_stats::WindowBias& bias, const std::vector<FrameStats>& fs,
+                     bool have_estimate) {
+  const auto& wb = bias.frames;
+  std::printf(
+      "\nmotion residuals as a radial distortion of every image + a + c/z per axis: k1 %+.5f, a_u "
+      "%+.3f "
+      "px, c_u %+.3f px m, a_v %+.3f px, c_v %+.3f px m; rms %.4f -> %.4f px; injected k1 "
+      "%+.5f\n",
+      bias.fit_k1, bias.fit_a_u_px, bias.fit_c_u_pxm, bias.fit_a_v_px, bias.fit_c_v_pxm,
+      bias.rms_before_px, bias.rms_after_px, bias.k1_used);
+  std::printf("\nmotion residual under the true motion by uL column in k-1 (du / dv px, pairs):\n");
+  for (const auto& c : bias.columns) {
+    std::printf("  u %4.0f-%4.0f: %+.3f / %+.3f (%zu)\n", c.u_min, c.u_max, c.mean_du, c.mean_dv,
+                c.n);
+  }
+  using sunvo::track_stats::FrameWindowBias;
+  using V = Eigen::Vector3d;
+  struct Term {
+    const char* name;
+    V FrameWindowBias::*field;
+  };
+  const Term terms[] = {{"all residuals", &FrameWindowBias::total},
+                        {"  of it u rows", &FrameWindowBias::from_u},
+                        {"  of it v rows", &FrameWindowBias::from_v},
+                        {"  of it d rows", &FrameWindowBias::from_d},
+                        {"injected vL shift alone", &FrameWindowBias::inject_v},
+                        {"injected vL shift c/z alone", &FrameWindowBias::inject_v_z},
+                        {"injected disparity bias alone", &FrameWindowBias::inject_d},
+                        {"injected radial distortion alone", &FrameWindowBias::inject_k1}};
+  std::printf(
+      "\nwindow at the true motion (window_bias.hpp): one-step rotation error summed, deg "
+      "(x pitch, y yaw, z roll)\n  %-31s %-26s %-26s\n",
+      "", "one-sided frames", "the others");
+  for (const Term& t : terms) {
+    V one = V::Zero(), bal = V::Zero();
+    for (std::size_t k = 1; k < wb.size(); ++k) (oneSided(fs[k]) ? one : bal) += wb[k].*t.field;
+    std::printf("  %-31s %+7.2f %+7.2f %+7.2f    %+7.2f %+7.2f %+7.2f\n", t.name, one.x() * 1e-3,
+                one.y() * 1e-3, one.z() * 1e-3, bal.x() * 1e-3, bal.y() * 1e-3, bal.z() * 1e-3);
+  }
+  {
+    double pr = 0.0, pl = 0.0, er = 0.0, el = 0.0;
+    int nr = 0, nl = 0;
+    for (std::size_t k = 1; k < wb.size(); ++k) {
+      if (!oneSided(fs[k])) continue;
+      const bool right = fs[k].left_share < 0.15;
+      (right ? pr : pl) += wb[k].total.z();
+      (right ? er : el) += fs[k].rot_err_c_mdeg.z();
+      ++(right ? nr : nl);
+    }
+    std::printf(
+        "  roll, all residuals: tracks right of cu (%d frames) %+.2f deg, left of cu (%d) %+.2f "
+        "deg",
+        nr, pr * 1e-3, nl, pl * 1e-3);
+    if (have_estimate) std::printf("; the estimate's: %+.2f and %+.2f deg", er * 1e-3, el * 1e-3);
+    std::printf("\n");
+  }
+  std::vector<double> s_one, s_bal;
+  for (std::size_t k = 1; k < wb.size(); ++k) {
+    if (wb[k].landmarks == 0) continue;
+    (oneSided(fs[k]) ? s_one : s_bal).push_back(wb[k].sigma_mdeg.z());
+  }
+  std::printf(
+      "  marginal roll std (1 px noise): one-sided median %.1f mdeg p95 %.1f; others median "
+      "%.1f p95 %.1f\n",
+      quantile(s_one, 0.5), quantile(s_one, 0.95), quantile(s_bal, 0.5), quantile(s_bal, 0.95));
+  if (!have_estimate) return;
+  double sxy = 0.0, sxx = 0.0, syy = 0.0;
+  for (std::size_t k = 1; k < wb.size(); ++k) {
+    const double x = wb[k].total.z(), y = fs[k].rot_err_c_mdeg.z();
+    sxy += x * y;
+    sxx += x * x;
+    syy += y * y;
+  }
+  std::printf(
+      "  estimate's per-frame roll error vs the predicted one: correlation (uncentred) %.3f, "
+      "slope %.3f\n",
+      sxy / std::sqrt(sxx * syy + 1e-30), sxy / (sxx + 1e-30));
 }
 }  // namespace
 
@@ -62,6 +148,19 @@ int main(int argc, char** argv) {
                  "per-frame rotation error of a jump, mdeg")
       ->check(CLI::Range(0.001, 1e6));
   app.add_option("--max-jumps", max_jumps, "jumps listed")->check(CLI::Range(0, 100000));
+  bool window_bias = false;
+  sunvo::track_stats::WindowBiasOptions wbo;
+  app.add_flag("--window-bias", window_bias,
+               "the two-frame window's first-order rotation error at the true motion, by "
+               "measurement and for injected error fields (window_bias.hpp)");
+  std::string window_bias_csv;
+  app.add_option("--window-bias-csv", window_bias_csv,
+                 "per-frame CSV of --window-bias (rotation errors in mdeg, camera k)");
+  app.add_option("--inject-v-px", wbo.inject_v_px, "injected constant vL shift, px");
+  app.add_option("--inject-v-z-pxm", wbo.inject_v_z_pxm, "injected vL shift c / z, px m");
+  app.add_option("--inject-d-px", wbo.inject_d_px, "injected disparity bias, px");
+  app.add_option("--inject-k1", wbo.inject_k1,
+                 "injected radial distortion k1 (0 = the one fitted to the motion residuals)");
   if (auto code = sunvo::cli::parse(app, argc, argv)) return *code;
 
   sunvo::files::TrackReadOptions tro;
@@ -199,6 +298,32 @@ int main(int argc, char** argv) {
         abs_one.size(), sum_one.x() * 1e-3, sum_one.y() * 1e-3, sum_one.z() * 1e-3,
         quantile(abs_one, 0.5), abs_bal.size(), sum_bal.x() * 1e-3, sum_bal.y() * 1e-3,
         sum_bal.z() * 1e-3, quantile(abs_bal, 0.5));
+  }
+  if (window_bias) {
+    auto wb = sunvo::track_stats::computeWindowBias(cam, seq->frames, seq->gt_T_0_k, wbo);
+    if (!wb) return sunvo::cli::fail(kProgram, wb.status());
+    printWindowBias(*wb, stats->frames, !estimate.empty());
+    if (!window_bias_csv.empty()) {
+      std::string csv =
+          "frame,landmarks,left_share,total_x,total_y,total_z,u_z,v_z,d_z,inject_v_z,"
+          "inject_vz_z,inject_d_z,sigma_x,sigma_y,sigma_z,est_x,est_y,est_z\n";
+      char line[512];
+      for (std::size_t k = 0; k < wb->frames.size(); ++k) {
+        const auto& w = wb->frames[k];
+        const FrameStats& f = stats->frames[k];
+        std::snprintf(line, sizeof(line),
+                      "%zu,%d,%.4f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,"
+                      "%.3f,%.3f,%.3f\n",
+                      k, w.landmarks, f.left_share, w.total.x(), w.total.y(), w.total.z(),
+                      w.from_u.z(), w.from_v.z(), w.from_d.z(), w.inject_v.z(), w.inject_v_z.z(),
+                      w.inject_d.z(), w.sigma_mdeg.x(), w.sigma_mdeg.y(), w.sigma_mdeg.z(),
+                      f.rot_err_c_mdeg.x(), f.rot_err_c_mdeg.y(), f.rot_err_c_mdeg.z());
+        csv += line;
+      }
+      if (auto s = sunvo::files::writeWholeFile(window_bias_csv, csv); !s.isOk()) {
+        return sunvo::cli::fail(kProgram, s);
+      }
+    }
   }
   std::printf(
       "\njumps: %zu (residual: mean du or dv more than %.1f robust sigmas from the "

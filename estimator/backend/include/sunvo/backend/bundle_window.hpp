@@ -71,6 +71,27 @@ struct WindowOptions {
   // given a predicted motion (e.g. constant velocity). 0 disables it.
   double motion_prior_sigma_rot_deg = 0.0;  // deg, >= 0: std of the rotation deviation
   double motion_prior_sigma_trans_m = 0.0;  // m, >= 0: std of the translation deviation
+  // Zero-mean prior on each window frame's rotation relative to the previous window frame
+  // (issue 15; RotationRatePriorResidual) along the pitch-like and roll-like directions
+  // orthogonal to the vehicle's yaw axis: std = rate std x dt, dt from the frame times (no prior
+  // when dt <= 0, dt taken as at least 1 ms). A ground vehicle's roll and pitch stay bounded; typical passenger-car body
+  // rates in normal driving are a few deg/s (roll gradient 3-6 deg/g with lateral jerk < 0.5 g/s;
+  // body modes at 1-1.5 Hz of 0.2-0.5 deg). It matters only on an axis the tracks constrain
+  // weakly (tracks on one side of the image leave roll weak). The yaw axis in the camera frame
+  // is the principal axis of the window's own per-frame rotations (turns dominate it),
+  // exponentially forgotten, starting at and regularised towards the camera's y axis (a camera
+  // looking along the direction of travel, x right, y down).
+  bool rotation_rate_prior = true;      // on/off
+  double rate_prior_pitch_deg_s = 2.0;  // deg/s, [0, 1000]: 0 = no prior on pitch
+  double rate_prior_yaw_deg_s = 0.0;    // deg/s, [0, 1000]: 0 = none (turns are the motion)
+  double rate_prior_roll_deg_s = 2.0;   // deg/s, [0, 1000]: 0 = no prior on roll
+  // Yaw-axis estimate: memory tau spans a few turns of urban driving; the regulariser outweighs
+  // what the body-rate wobble adds over tau on a straight road ((rate std x dt)^2 x tau / dt =
+  // (0.2 deg)^2 x 200 frames = 8 deg^2 at 2 deg/s and 10 Hz < 9 deg^2), so a long straight
+  // cannot tilt the axis, while one frame of a 3 deg/frame turn already weighs 9 deg^2.
+  double yaw_axis_memory_s = 20.0;  // s, (0, 1e6]: time constant of the yaw-axis estimate
+  double yaw_axis_prior_deg = 3.0;  // deg, (0, 180]: turning the camera's y axis counts as in the
+                                    // yaw-axis estimate (its weight against observed turns)
 
   Status validate() const;
   template <class Self, class V>
@@ -89,6 +110,12 @@ struct WindowOptions {
     v("max_solver_time_in_seconds", s.max_solver_time_in_seconds);
     v("motion_prior_sigma_rot_deg", s.motion_prior_sigma_rot_deg);
     v("motion_prior_sigma_trans_m", s.motion_prior_sigma_trans_m);
+    v("rotation_rate_prior", s.rotation_rate_prior);
+    v("rate_prior_pitch_deg_s", s.rate_prior_pitch_deg_s);
+    v("rate_prior_yaw_deg_s", s.rate_prior_yaw_deg_s);
+    v("rate_prior_roll_deg_s", s.rate_prior_roll_deg_s);
+    v("yaw_axis_memory_s", s.yaw_axis_memory_s);
+    v("yaw_axis_prior_deg", s.yaw_axis_prior_deg);
   }
 };
 
@@ -102,6 +129,7 @@ struct WindowSolveSummary {
   int num_landmarks = 0;
   int num_stereo_residuals = 0;
   int num_prior_residuals = 0;
+  int num_rate_prior_residuals = 0;  // rotation-rate priors (WindowOptions::rotation_rate_prior)
   int num_extra_residuals = 0;
   int iterations = 0;
   double solver_time_s = 0.0;
@@ -137,8 +165,12 @@ class BundleWindow {
   Expected<WindowSolveSummary> solve();
 
   // Puts every pose back to the initial guess it had before the last solve() (e.g. when the
-  // caller rejects the solution).
-  void restoreInitialGuess() { poses_ = saved_poses_; }
+  // caller rejects the solution), and the yaw-axis estimate to what it was before that solve.
+  void restoreInitialGuess() {
+    poses_ = saved_poses_;
+    yaw_scatter_ = saved_yaw_scatter_;
+    yaw_axis_c_ = saved_yaw_axis_c_;
+  }
 
   int size() const { return size_; }
   const Isometry3& T_w_b() const { return T_w_b_; }
@@ -172,6 +204,10 @@ class BundleWindow {
 
   const WindowOptions& options() const { return options_; }
 
+  // The vehicle's yaw (turn) axis in the camera frame as estimated so far (unit, y >= 0); the
+  // rotation-rate prior acts orthogonal to it. Kept across reset() (a property of the rig).
+  const Eigen::Vector3d& yawAxis() const { return yaw_axis_c_; }
+
   // Time limit of the following solves, s: a real-time caller shrinks it when a frame is late.
   // Clamped to (0, options.max_solver_time_in_seconds]; a non-finite or non-positive value
   // restores the configured limit. init() also restores it.
@@ -185,7 +221,8 @@ class BundleWindow {
     std::vector<WindowObservation> obs;  // capacity max_observations_per_frame
     int num_obs = 0;
     bool has_prior = false;
-    MotionPriorData prior;  // relative to the previous slot
+    MotionPriorData prior;             // relative to the previous slot
+    RotationRatePriorData rate_prior;  // relative to the previous slot, set in solve()
   };
   struct PoseBlock {
     std::array<double, 4> q{0.0, 0.0, 0.0, 1.0};  // q_k_b, Eigen order x y z w
@@ -202,6 +239,10 @@ class BundleWindow {
   // Normalises the quaternions of slots 1..; false when a pose is not finite.
   bool normalizePoses();
   void clearResiduals();
+  // Sets the rotation-rate priors' bases and weights from the frame times and the yaw axis.
+  Status addRatePriors(WindowSolveSummary& out, bool use_ceres);
+  // Adds the newest frame's relative rotation to the yaw-axis estimate (after a solve).
+  void updateYawAxis();
 
   WindowOptions options_;
   double time_budget_s_ = 0.0;  // limit of the next solve, (0, options_.max_solver_time_in_seconds]
@@ -218,6 +259,7 @@ class BundleWindow {
   std::vector<StereoMeasurement> measurements_;   // one per stereo cost function
   std::vector<std::unique_ptr<ceres::CostFunction>> cost_pool_;  // solver == kCeres only
   std::array<std::unique_ptr<ceres::CostFunction>, kMaxWindowSize> prior_pool_;
+  std::array<std::unique_ptr<ceres::CostFunction>, kMaxWindowSize> rate_prior_pool_;
   std::vector<ceres::ResidualBlockId> residual_ids_;
   int num_residuals_ = 0;
   std::unique_ptr<ceres::LossFunction> loss_;
@@ -227,6 +269,10 @@ class BundleWindow {
   PoseResidualHook hook_;
   PostSolveHook post_hook_;
   bool in_hook_ = false;
+  Eigen::Matrix3d yaw_scatter_ = Eigen::Matrix3d::Zero();  // rad^2, sum of phi phi^T (forgotten)
+  Eigen::Vector3d yaw_axis_c_ = Eigen::Vector3d::UnitY();
+  Eigen::Matrix3d saved_yaw_scatter_ = Eigen::Matrix3d::Zero();  // before the last solve
+  Eigen::Vector3d saved_yaw_axis_c_ = Eigen::Vector3d::UnitY();
   int num_extra_ = 0;
 };
 

@@ -128,4 +128,54 @@ class MotionPriorResidual {
   const MotionPriorData* prior_;
 };
 
+// The rotation-rate prior between two consecutive window frames (issue 15): an orthonormal basis
+// of camera k whose row 1 is the vehicle's yaw (turn) axis and whose rows 0 and 2 are the
+// pitch-like and roll-like (closest to the optical axis) directions orthogonal to it, and the
+// weights 1 / (rate std x dt) per row (0 = no prior along that row).
+struct RotationRatePriorData {
+  double basis[9] = {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0};  // row-major
+  double sqrt_info[3] = {0.0, 0.0, 0.0};                            // 1/rad
+};
+
+// Zero-mean prior on the rotation between consecutive window frames km1 and k, along the
+// directions orthogonal to the yaw axis:
+//   C_k_km1 = C_k_b C_km1_b^T,  q_rel = q_k_b * q_km1_b^-1 = (sin(a/2) n, cos(a/2)),
+//   phi = 2 vec(q_rel) ~ a n for a small rotation (sign chosen so that q_rel.w >= 0),
+//   r_i = sqrt_info_i * (B phi)_i,  B the basis above.
+// A ground vehicle's roll and pitch angles stay bounded, so the rotation about axes orthogonal to
+// its turn axis has zero mean: pulling a frame's roll towards 0 costs at most a bounded share of
+// the net roll change, while the window alone lets a systematic image error accumulate as roll on
+// frames whose tracks do not constrain it (docs/backend.md, the roll of one-sided frames). Its
+// influence is large only where the window's own information on an axis is small. The yaw axis
+// is not the camera's y axis on a real rig (on the 0020 tracks the estimate ends 2.2 deg off),
+// which is why it is estimated (BundleWindow::yawAxis) and the prior acts orthogonal to it, not
+// about the camera's x and z.
+class RotationRatePriorResidual {
+ public:
+  explicit RotationRatePriorResidual(const RotationRatePriorData* prior) : prior_(prior) {}
+
+  template <typename T>
+  bool operator()(const T* q_km1_b, const T* q_k_b, T* residual) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> q_km1(q_km1_b);
+    const Eigen::Map<const Eigen::Quaternion<T>> q_k(q_k_b);
+    const Eigen::Quaternion<T> q_rel = q_k * q_km1.conjugate();
+    const T two_sign = q_rel.w() < T(0.0) ? T(-2.0) : T(2.0);
+    const T phi[3] = {two_sign * q_rel.x(), two_sign * q_rel.y(), two_sign * q_rel.z()};
+    for (int i = 0; i < 3; ++i) {
+      const double* b = prior_->basis + 3 * i;
+      residual[i] =
+          T(prior_->sqrt_info[i]) * (T(b[0]) * phi[0] + T(b[1]) * phi[1] + T(b[2]) * phi[2]);
+    }
+    return true;
+  }
+
+  static ceres::CostFunction* Create(const RotationRatePriorData* prior) {
+    return new ceres::AutoDiffCostFunction<RotationRatePriorResidual, 3, 4, 4>(
+        new RotationRatePriorResidual(prior));
+  }
+
+ private:
+  const RotationRatePriorData* prior_;
+};
+
 }  // namespace sunvo::backend

@@ -87,6 +87,8 @@ class SunAidedOdometry {
   // The features of the last image frame (valid until the next call).
   const FrameFeatures& lastFeatures() const { return vo_.lastFeatures(); }
   const SunAidedOptions& options() const { return options_; }
+  // The back end's window, e.g. its yaw-axis estimate (BundleWindow::yawAxis).
+  const backend::BundleWindow& window() { return backEnd().window(); }
 
  private:
   vo::StereoTrackOdometry& backEnd() {
