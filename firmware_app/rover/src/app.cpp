@@ -396,6 +396,12 @@ std::string RoverApp::summary() const {
           g(h.heartbeats), g(h.link_errors));
   appendf(&o, "  tracking: losses %" PRIu64 ", recoveries %" PRIu64 ", lost frames %" PRIu64 "\n",
           g(h.tracking_losses), g(h.recoveries), g(h.lost_frames));
+  if (s.config.estimator.pipeline.self_calibration.enabled) {
+    constexpr double kUradToDeg = 180.0 / 3.141592653589793 * 1e-6;
+    appendf(&o, "  self-calibration: right pitch %+.4f deg, roll %+.4f deg, resets %" PRIu64 "\n",
+            kUradToDeg * static_cast<double>(h.self_cal_pitch_urad.load()),
+            kUradToDeg * static_cast<double>(h.self_cal_roll_urad.load()), g(h.self_cal_resets));
+  }
   appendf(&o,
           "  sun (%s): requests %" PRIu64 ", measurements %" PRIu64 ", errors %" PRIu64
           ", late %" PRIu64 ", accepted %" PRIu64 ", rejected %" PRIu64 "\n",

@@ -163,6 +163,13 @@ void EstimatorStage::run() {
       health.recoveries.fetch_add(1, std::memory_order_relaxed);
       ++reset_counter_;
     }
+    if (odometry_.options().pipeline.self_calibration.enabled) {
+      const selfcal::SelfCalibrationReport& sc = r->self_calibration;
+      health.self_cal_pitch_urad.store(std::llround(1e3 * sc.pitch_mrad),
+                                       std::memory_order_relaxed);
+      health.self_cal_roll_urad.store(std::llround(1e3 * sc.roll_mrad), std::memory_order_relaxed);
+      health.self_cal_resets.store(sc.resets, std::memory_order_relaxed);
+    }
     const sunfusion::GateCounters& gate = odometry_.sunCounters();
     health.sun_accepted.store(gate.accepted, std::memory_order_relaxed);
     health.sun_rejected.store(gate.total() - gate.accepted, std::memory_order_relaxed);

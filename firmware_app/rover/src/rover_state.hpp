@@ -63,6 +63,11 @@ struct Health {
   std::atomic<std::uint64_t> tracking_losses{0};
   std::atomic<std::uint64_t> recoveries{0};
   std::atomic<std::uint64_t> lost_frames{0};
+  // estimator.self_calibration: the right camera's estimated pitch and roll (microradians, the
+  // last frame's) and the resets of a diverged estimate.
+  std::atomic<std::int64_t> self_cal_pitch_urad{0};
+  std::atomic<std::int64_t> self_cal_roll_urad{0};
+  std::atomic<std::uint64_t> self_cal_resets{0};
   std::atomic<std::uint64_t> sun_requests{0};
   std::atomic<std::uint64_t> sun_measurements{0};
   std::atomic<std::uint64_t> sun_errors{0};
