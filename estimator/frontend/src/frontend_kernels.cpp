@@ -1,7 +1,8 @@
 // The front end's image kernels (declared in frontend_kernels.hpp), each a simple loop over one
 // row that the compiler vectorises. SUNVO_SIMD_CLONES builds an x86-64 kernel for the baseline
-// ISA and for AVX2 and lets the dynamic loader pick one by the CPU it runs on (an ifunc); other
-// targets (aarch64 with NEON, sanitizer builds) get the one plain version.
+// ISA, for AVX2 and for x86-64-v4 (AVX-512) and lets the dynamic loader pick one by the CPU it
+// runs on (an ifunc); other targets (aarch64 with NEON, sanitizer builds) get the one plain
+// version.
 
 #include "frontend_kernels.hpp"
 

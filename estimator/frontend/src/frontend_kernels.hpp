@@ -115,10 +115,10 @@ inline std::int64_t rowSsd(const std::uint8_t* __restrict a, const std::uint8_t*
   return sum;
 }
 
-// The image kernels below are defined in frontend_kernels.cpp. On x86-64 each is compiled twice,
-// for the baseline (SSE2) and for AVX2, and the loader picks one per CPU (GCC/Clang function
-// multiversioning): the package stays runnable on any x86-64 while a CPU with AVX2 does twice the
-// lanes per instruction. They are integer-only, so both versions give bit-identical results.
+// The image kernels below are defined in frontend_kernels.cpp. On x86-64 (GCC) each is compiled
+// three times, for the baseline (SSE2), AVX2 and x86-64-v4, and the loader picks one per CPU
+// (function multiversioning): the package stays runnable on any x86-64 while a newer CPU does
+// more lanes per instruction. They are integer-only, so every version gives bit-identical results.
 // restrict-qualified parameters let the compiler vectorise without alias checks.
 
 // out_max[i] = max(a[i], b[i]), out_min[i] = min(c[i], d[i]) for i in [0, count). Inputs may

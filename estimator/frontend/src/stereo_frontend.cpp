@@ -239,11 +239,10 @@ std::int64_t StereoFrontend::denseCost(int ul, int ur, int v, int dv_right) cons
 // by boundary terms, so the cost is symmetric about its minimum and the parabola is unbiased,
 // whereas the sparse samples make it lopsided (0.2-0.3 px bias measured on exact shifts).
 // The window is centred on the left keypoint's whole pixel, so its subpixel offset du carries
-// over to the right: u_right = u_r + s + delta + du. With measure_v_right the same cost is
-// sampled with the right window one row up and down at the refined column, and a parabola
-// through the three gives the right row: v_right = v_l + delta_v + dv (else v_right = v_left,
-// as rectification promises). A rig whose rectification is off by a fraction of a pixel shows it
-// there (what the stereo self-calibration estimates).
+// over to the right: u_right = u_r + s + delta + du. With measure_v_right the right row is
+// measured too (measureRightRow); else v_right = v_left, as rectification promises. A rig whose
+// rectification is off by a fraction of a pixel shows it there (what the stereo
+// self-calibration estimates).
 bool StereoFrontend::refineStereo(int li, int ri, StereoObservation& obs) const {
   const CandidateSet& l = left_[static_cast<std::size_t>(cur_)];
   const CandidateSet& r = right_[static_cast<std::size_t>(cur_)];
@@ -315,8 +314,7 @@ void StereoFrontend::measureRightRow(const Keypoint& lk, int ur, int sv,
             clipped(R[r + stride_]) || clipped(R[r - stride_])) {
           continue;
         }
-        // Derivatives averaged over both images (symmetric step: its error is third order in
-        // the offset, a one-sided step's second order).
+        // Derivatives averaged over both images (a symmetric step).
         const double rx = 0.25 * (int{R[r + 1]} - int{R[r - 1]} + int{L[l + 1]} - int{L[l - 1]});
         const double ry = 0.25 * (int{R[r + stride_]} - int{R[r - stride_]} + int{L[l + stride_]} -
                                   int{L[l - stride_]});
