@@ -46,7 +46,7 @@ for r in "${tracks[@]}"; do
     mkdir -p "$out/tracks_$id"
     "$bin/sunvo_experiment" --routes "$r" --out "$out/tracks_$id/$side" "${flag[@]}" \
       > "$out/tracks_$id/$side.log" 2>&1
-    json=$(ls "$out/tracks_$id/$side"/route_*_metrics.json | head -1)
+    json=$(find "$out/tracks_$id/$side" -maxdepth 1 -name "route_*_metrics.json" | head -1)
     printf 'tracks %s\t%s\t%s\t%s\n' "$id" "$side" "$json" \
       "$(grep -m1 -o 'self-calibration[^|]*' "$out/tracks_$id/$side.log" || true)" >> "$rows"
   done
