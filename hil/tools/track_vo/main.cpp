@@ -72,17 +72,7 @@ int main(int argc, char** argv) {
   app.add_option("--prior-rot-deg", win.motion_prior_sigma_rot_deg, "motion prior, deg");
   app.add_option("--prior-trans-m", win.motion_prior_sigma_trans_m, "motion prior, m");
   app.add_option("--seed", opt.seed, "RANSAC seed");
-  app.add_flag("!--no-rate-prior", win.rotation_rate_prior,
-               "no zero-mean rotation-rate prior in the window (window.rotation_rate_prior)");
-  app.add_option("--rate-prior-pitch", win.rate_prior_pitch_deg_s,
-                 "rotation-rate prior std about the camera x axis, deg/s (0 = none)")
-      ->check(CLI::Range(0.0, 1000.0));
-  app.add_option("--rate-prior-yaw", win.rate_prior_yaw_deg_s,
-                 "rotation-rate prior std about the camera y axis, deg/s (0 = none)")
-      ->check(CLI::Range(0.0, 1000.0));
-  app.add_option("--rate-prior-roll", win.rate_prior_roll_deg_s,
-                 "rotation-rate prior std about the optical axis, deg/s (0 = none)")
-      ->check(CLI::Range(0.0, 1000.0));
+  sunvo::cli::addRotationRatePriorOptions(app, win);
   app.add_option("--log", args.log_path, "per-frame CSV log");
   sunvo::selfcal::StereoSelfCalibrationOptions selfcal_opt;  // issue 15: off unless --self-calib
   app.add_flag("--self-calib", selfcal_opt.enabled,

@@ -61,7 +61,6 @@ int main(int argc, char** argv) {
   bool fixed_drift = false;
   bool self_calib = false;
   sunvo::experiment::ExperimentOptions options;
-  bool rate_prior = true;
   std::string drift_rule = "persistence";
   std::string forms_arg = "sunvo";
   CLI::App app{
@@ -89,25 +88,7 @@ int main(int argc, char** argv) {
                  "comma-separated fusion forms, each a column per source: sunvo (the base "
                  "attitude is estimated), paper (held fixed, as the paper did)");
   app.add_flag("--fixed-drift", fixed_drift, "keep the random walk at --drift-deg");
-  app.add_flag(
-      "!--no-rate-prior", rate_prior,
-      "VO without the window's zero-mean rotation-rate prior (window.rotation_rate_prior)");
-  sunvo::backend::WindowOptions& win = options.vo.window;
-  app.add_option("--rate-prior-pitch", win.rate_prior_pitch_deg_s,
-                 "rotation-rate prior std about the camera x axis, deg/s (0 = none)")
-      ->check(CLI::Range(0.0, 1000.0));
-  app.add_option("--rate-prior-yaw", win.rate_prior_yaw_deg_s,
-                 "rotation-rate prior std about the camera y axis, deg/s (0 = none)")
-      ->check(CLI::Range(0.0, 1000.0));
-  app.add_option("--rate-prior-roll", win.rate_prior_roll_deg_s,
-                 "rotation-rate prior std about the optical axis, deg/s (0 = none)")
-      ->check(CLI::Range(0.0, 1000.0));
-  app.add_option("--yaw-axis-memory-s", win.yaw_axis_memory_s,
-                 "time constant of the window's yaw-axis estimate, s")
-      ->check(CLI::Range(1e-3, 1e6));
-  app.add_option("--yaw-axis-prior-deg", win.yaw_axis_prior_deg,
-                 "weight of the camera's y axis in the yaw-axis estimate, deg of turning")
-      ->check(CLI::Range(1e-3, 180.0));
+  sunvo::cli::addRotationRatePriorOptions(app, options.vo.window);
   app.add_flag("--self-calib", self_calib,
                "online stereo self-calibration of the right camera before the odometry");
   app.add_option("--drift-rule", drift_rule, "how the random walk adapts")
@@ -143,7 +124,6 @@ int main(int argc, char** argv) {
   options.every_n_frames = every;
   options.max_frames = frames;
   options.self_calibration.enabled = self_calib;
-  options.vo.window.rotation_rate_prior = rate_prior;
   // A replay is bounded by solver iterations only: a wall-clock limit would make the result
   // depend on the machine's load. (The onboard program keeps its time budget.)
   options.vo.window.max_solver_time_in_seconds = 60.0;

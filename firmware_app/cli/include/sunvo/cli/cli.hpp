@@ -33,4 +33,30 @@ int fail(const std::string& program, const std::string& message);
 // The project version, e.g. "0.1.0".
 const char* version();
 
+// The window's rotation-rate prior switches (backend::WindowOptions, docs/backend.md), the same
+// in every program that runs the back end: --no-rate-prior, --rate-prior-pitch/-yaw/-roll
+// (deg/s), --yaw-axis-memory-s, --yaw-axis-prior-deg. A template so that this library needs
+// nothing of the back end.
+template <class WindowOptions>
+void addRotationRatePriorOptions(CLI::App& app, WindowOptions& win) {
+  app.add_flag(
+      "!--no-rate-prior", win.rotation_rate_prior,
+      "VO without the window's zero-mean rotation-rate prior (window.rotation_rate_prior)");
+  app.add_option("--rate-prior-pitch", win.rate_prior_pitch_deg_s,
+                 "rotation-rate prior std about the camera x axis, deg/s (0 = none)")
+      ->check(CLI::Range(0.0, 1000.0));
+  app.add_option("--rate-prior-yaw", win.rate_prior_yaw_deg_s,
+                 "rotation-rate prior std about the camera y axis, deg/s (0 = none)")
+      ->check(CLI::Range(0.0, 1000.0));
+  app.add_option("--rate-prior-roll", win.rate_prior_roll_deg_s,
+                 "rotation-rate prior std about the optical axis, deg/s (0 = none)")
+      ->check(CLI::Range(0.0, 1000.0));
+  app.add_option("--yaw-axis-memory-s", win.yaw_axis_memory_s,
+                 "time constant of the window's yaw-axis estimate, s")
+      ->check(CLI::Range(1e-3, 1e6));
+  app.add_option("--yaw-axis-prior-deg", win.yaw_axis_prior_deg,
+                 "weight of the camera's y axis in the yaw-axis estimate, deg of turning")
+      ->check(CLI::Range(1e-3, 180.0));
+}
+
 }  // namespace sunvo::cli
