@@ -2,7 +2,7 @@
 
 #include <gtest/gtest.h>
 
-#include "sunvo/simtracks/simulated_tracks.hpp"
+#include "../support/exact_tracks.hpp"
 
 namespace sunvo::track_stats {
 namespace {
@@ -28,12 +28,7 @@ std::vector<Isometry3> drive(int frames) {
 }
 
 std::vector<FrameFeatures> cleanTracks(const std::vector<Isometry3>& T_0_k) {
-  simtracks::SimTrackOptions sim;
-  sim.pixel_noise_px = 0.0;
-  sim.outlier_share = 0.0;
-  auto frames = simtracks::simulateTracks(T_0_k, {}, kittiCamera(), sim);
-  EXPECT_TRUE(frames) << frames.status().toString();
-  return frames ? *frames : std::vector<FrameFeatures>();
+  return testing::exactTracks(T_0_k, kittiCamera());
 }
 
 TEST(TrackStats, CleanTracksHaveNoErrorAnywhere) {
