@@ -1,7 +1,5 @@
 // Delaunay triangulation for libviso2's outlier removal through OpenCV's
-// Subdiv2D (see triangle.h). Counts its own thread-CPU time and prints the
-// total at exit, so a benchmark can state how much of libviso2's time the
-// stand-in took.
+// Subdiv2D (see triangle.h); its thread-CPU time is counted (shim_stats.hpp).
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -10,28 +8,12 @@
 #include <unordered_map>
 #include <vector>
 
+#include "shim_stats.hpp"
 #include "triangle.h"
 
 namespace {
 
-double threadCpuSeconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
-
-struct ShimStats {
-  long calls = 0;
-  double cpu_s = 0.0;
-  ~ShimStats() {
-    if (calls > 0 && std::getenv("LIBVISO2_SHIM_QUIET") == nullptr)
-      std::fprintf(stderr,
-                   "libviso2 triangle shim (OpenCV Subdiv2D): %ld calls, "
-                   "%.1f ms thread-CPU total, %.3f ms per call\n",
-                   calls, 1e3 * cpu_s, 1e3 * cpu_s / calls);
-  }
-};
-ShimStats g_stats;
+ShimStats g_stats{"OpenCV Subdiv2D"};
 
 std::uint64_t key(float x, float y) {
   std::uint32_t bx, by;
@@ -44,7 +26,7 @@ std::uint64_t key(float x, float y) {
 
 void triangulate(char*, struct triangulateio* in, struct triangulateio* out,
                  struct triangulateio*) {
-  const double t0 = threadCpuSeconds();
+  const double t0 = shimThreadCpuSeconds();
   const int n = in->numberofpoints;
   float x_min = in->pointlist[0], x_max = x_min;
   float y_min = in->pointlist[1], y_max = y_min;
@@ -87,6 +69,5 @@ void triangulate(char*, struct triangulateio* in, struct triangulateio* out,
   if (!corners.empty())
     std::memcpy(out->trianglelist, corners.data(), corners.size() * sizeof(int));
   out->pointlist = nullptr;
-  g_stats.calls++;
-  g_stats.cpu_s += threadCpuSeconds() - t0;
+  g_stats.add(n, t0);
 }

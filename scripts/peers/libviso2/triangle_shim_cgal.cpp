@@ -1,8 +1,7 @@
 // Delaunay triangulation for libviso2's outlier removal through CGAL's
 // Delaunay_triangulation_2 (see triangle.h), a stand-in for Shewchuk's Triangle
-// of about its speed (both O(n log n) with exact predicates). Counts its own
-// thread-CPU time and prints the total at exit, so a benchmark can state how
-// much of libviso2's time the stand-in took. sunvo's code; peer builds only.
+// of about its speed (both O(n log n) with exact predicates); its thread-CPU
+// time is counted (shim_stats.hpp). sunvo's code; peer builds only.
 #include <CGAL/Delaunay_triangulation_2.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
@@ -14,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "shim_stats.hpp"
 #include "triangle.h"
 
 namespace {
@@ -23,31 +23,13 @@ using VertexBase = CGAL::Triangulation_vertex_base_with_info_2<int, Kernel>;
 using Tds = CGAL::Triangulation_data_structure_2<VertexBase>;
 using Delaunay = CGAL::Delaunay_triangulation_2<Kernel, Tds>;
 
-double threadCpuSeconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
-
-struct ShimStats {
-  long calls = 0;
-  long points = 0;
-  double cpu_s = 0.0;
-  ~ShimStats() {
-    if (calls > 0 && std::getenv("LIBVISO2_SHIM_QUIET") == nullptr)
-      std::fprintf(stderr,
-                   "libviso2 triangle shim (CGAL Delaunay_triangulation_2): %ld calls, "
-                   "%.1f points per call, %.1f ms thread-CPU total, %.3f ms per call\n",
-                   calls, static_cast<double>(points) / calls, 1e3 * cpu_s, 1e3 * cpu_s / calls);
-  }
-};
-ShimStats g_stats;
+ShimStats g_stats{"CGAL Delaunay_triangulation_2"};
 
 }  // namespace
 
 void triangulate(char*, struct triangulateio* in, struct triangulateio* out,
                  struct triangulateio*) {
-  const double t0 = threadCpuSeconds();
+  const double t0 = shimThreadCpuSeconds();
   const int n = in->numberofpoints;
   std::vector<std::pair<Kernel::Point_2, int>> points;
   points.reserve(static_cast<std::size_t>(n));
@@ -68,7 +50,5 @@ void triangulate(char*, struct triangulateio* in, struct triangulateio* out,
   if (!corners.empty())
     std::memcpy(out->trianglelist, corners.data(), corners.size() * sizeof(int));
   out->pointlist = nullptr;
-  g_stats.calls++;
-  g_stats.points += n;
-  g_stats.cpu_s += threadCpuSeconds() - t0;
+  g_stats.add(n, t0);
 }
