@@ -294,11 +294,13 @@ bool StereoFrontend::refineStereo(int li, int ri, StereoObservation& obs) const 
 // central differences averaged over both images for R_x, R_y (a symmetric step). Both offsets
 // are solved (the column's is not whole either) and only dv is used: v_right = v + sv + dv +
 // dv_left (the keypoint's own subpixel row). The row is kept when the window determines it: the
-// smaller eigenvalue of the 2x2 matrix at least kMinRowCurvatureRatio of the larger (not along
+// smaller eigenvalue of the 2x2 matrix at least kMinEigenvalueRatio of the larger (not along
 // an edge) and |dv| <= 1 px.
 void StereoFrontend::measureRightRow(const Keypoint& lk, int ur, int sv,
                                      StereoObservation& obs) const {
   const std::ptrdiff_t right_shift = static_cast<std::ptrdiff_t>(sv) * stride_;
+  // A gradient stored at 0 or 255 was clipped (|g| > 255): not linear in the offset.
+  auto clipped = [](std::uint8_t g) { return g == 0 || g == 255; };
   double a11 = 0.0, a12 = 0.0, a22 = 0.0, b1 = 0.0, b2 = 0.0;
   for (int ch = 0; ch < 2; ++ch) {
     const std::uint8_t* L = (ch == 0 ? gx_ : gy_)[0].data();
@@ -308,8 +310,6 @@ void StereoFrontend::measureRightRow(const Keypoint& lk, int ur, int sv,
       for (int dx = -kRefineRadius; dx <= kRefineRadius; ++dx) {
         const std::ptrdiff_t r = row + right_shift + ur + dx;
         const std::ptrdiff_t l = row + lk.u + dx;
-        // A gradient stored at 0 or 255 was clipped (|g| > 255): not linear in the offset.
-        auto clipped = [](std::uint8_t g) { return g == 0 || g == 255; };
         if (clipped(L[l]) || clipped(R[r]) || clipped(R[r + 1]) || clipped(R[r - 1]) ||
             clipped(R[r + stride_]) || clipped(R[r - stride_])) {
           continue;
@@ -332,7 +332,7 @@ void StereoFrontend::measureRightRow(const Keypoint& lk, int ur, int sv,
   const double disc = std::sqrt(std::max(0.0, 0.25 * tr * tr - det));
   const double lmin = 0.5 * tr - disc;
   const double lmax = 0.5 * tr + disc;
-  if (!(det > 0.0) || !(lmin >= kMinRowCurvatureRatio * lmax)) return;
+  if (!(det > 0.0) || !(lmin >= kMinEigenvalueRatio * lmax)) return;
   const double dv = (a11 * b2 - a12 * b1) / det;
   if (!std::isfinite(dv) || std::abs(dv) > 1.0) return;
   obs.v_right = lk.v + sv + dv + static_cast<double>(lk.dv);

@@ -64,7 +64,8 @@ struct FrontendOptions {
   int max_sad = 1200;                  // SAD of 32 uint8 samples, [1, 8160]: worse matches rejected
   double circular_tolerance_px = 1.5;  // px, [0, 100]: the circle must close this close
   int lr_tolerance = 1;                // px, [0, 10]: left->right->left check for new features
-  bool measure_v_right = false;        // subpixel right row of every match (else v_right =
+  bool measure_v_right = false;        // subpixel right row of every match whose window
+                                       //   determines it (v_right_measured; else v_right =
                                        //   v_left); what stereo self-calibration needs
 
   Status validate() const;
@@ -186,7 +187,7 @@ class StereoFrontend {
   // an edge: the smaller eigenvalue of the Lucas-Kanade matrix at least this fraction of the
   // larger (the row then at most ~2x less certain than the best-determined direction); else
   // v_right_measured = false.
-  static constexpr double kMinRowCurvatureRatio = 0.25;
+  static constexpr double kMinEigenvalueRatio = 0.25;
 
   // img_index 0 = left, 1 = right: which gradient buffers are written / read.
   void smooth(const cv::Mat& img);
