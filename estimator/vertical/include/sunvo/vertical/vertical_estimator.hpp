@@ -1,0 +1,106 @@
+#pragma once
+// The camera's "up" from the vertical vanishing point of one gray image: a gravity (roll/pitch)
+// cue from what city images show for free, the vertical edges of buildings, poles and windows.
+//
+// Model. A 3-D line with direction up_c (unit, camera frame) projects to an image segment whose
+// interpretation plane (the plane through the camera centre and the segment) has the unit normal
+//   n = K^T l / |K^T l|,   l = a_h x b_h   (a, b the segment's end points, homogeneous),
+// and since the plane contains the line, n . up_c = 0. For many vertical segments up_c is the
+// direction least out of all their planes: with weights w_i (segment length, px),
+//   up_c = argmin_|u|=1  sum_i w_i (n_i . u)^2,
+// the eigenvector of M = sum_i w_i n_i n_i^T with the smallest eigenvalue. Its residual
+// s^2 = u^T M u / (sum_i w_i - 2) (rad^2 per unit weight) and the other two eigenvalues l_1, l_2
+// of M give the covariance of u in its tangent plane, s^2 / l_j along eigenvector j; the reported
+// sigma is the larger of the two, floored at min_sigma_deg (real scenes lean a little).
+//
+// Which segments are vertical is found by RANSAC: candidates are the segments whose plane is
+// within max_tilt_deg of the prior up (the current attitude, or level); two candidates give
+// u = n_i x n_j, and the hypothesis with the most length within inlier_angle_deg
+// (|n . u| < sin(inlier_angle_deg)) wins and is refined by the eigenvector twice, re-selecting
+// its inliers each time. One sun-like absolute direction per image: the caller puts it next to
+// the sun as a residual on the attitude (the world's up is known exactly).
+//
+// Segments: OpenCV's line segment detector on the image, downscaled to at most max_width_px
+// columns (a 1241-px KITTI image to 640: 4x less CPU, and on the full-resolution drives measured
+// no less accurate; docs/vertical.md). Buffers are
+// kept between calls; the detector itself allocates inside OpenCV.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+#include <vector>
+
+#include "sunvo/core/camera.hpp"
+#include "sunvo/core/status.hpp"
+
+namespace sunvo::vertical {
+
+struct VerticalOptions {
+  double max_tilt_deg = 15.0;     // deg, (0, 60]: candidates' planes within this of the prior up
+  double inlier_angle_deg = 0.5;  // deg, (0, 10]: |n . u| bound of an inlier
+  double min_segment_px = 20.0;   // px at full resolution, [5, 2000]: shorter segments unused
+  int min_inliers = 8;            // [3, 10000]: fewer inliers = invalid
+  double max_sigma_deg = 3.0;     // deg, (0, 90]: a larger sigma = invalid
+  double min_sigma_deg = 0.2;     // deg, (0, 10]: floor of the reported sigma
+  double line_sigma_deg = 1.0;    // deg, (0, 10]: error of one segment's plane angle
+  int ransac_iterations = 300;    // [1, 100000]
+  std::uint32_t seed = 1;         // RANSAC's sampler, reset per call: same image, same answer
+  int max_width_px = 640;         // px, [64, 100000]: wider images are downscaled to it first
+
+  Status validate() const;
+  template <class Self, class V>
+  static void fields(Self& s, V& v) {
+    v("max_tilt_deg", s.max_tilt_deg);
+    v("inlier_angle_deg", s.inlier_angle_deg);
+    v("min_segment_px", s.min_segment_px);
+    v("min_inliers", s.min_inliers);
+    v("max_sigma_deg", s.max_sigma_deg);
+    v("min_sigma_deg", s.min_sigma_deg);
+    v("line_sigma_deg", s.line_sigma_deg);
+    v("ransac_iterations", s.ransac_iterations);
+    v("seed", s.seed);
+    v("max_width_px", s.max_width_px);
+  }
+};
+
+struct VerticalMeasurement {
+  bool valid = false;
+  Eigen::Vector3d up_c = Eigen::Vector3d(0.0, -1.0, 0.0);  // unit, camera frame (x right, y down)
+  double sigma_rad = 0.0;   // 1-sigma angle of up_c (its worse tangent direction)
+  int candidates = 0;       // segments near the prior's vertical
+  int inliers = 0;          // segments of the winning vanishing point
+  const char* reason = "";  // why invalid ("" when valid)
+};
+
+class VerticalEstimator {
+ public:
+  Status init(const VerticalOptions& options, const StereoCamera& camera);
+  // gray: CV_8UC1 of the camera's size. up_prior_c: unit, where "up" is expected (level camera:
+  // (0, -1, 0)). Errors only for bad input; "no vertical found" is a measurement with
+  // valid = false and a reason. Never NaN.
+  Expected<VerticalMeasurement> estimate(const cv::Mat& gray, const Eigen::Vector3d& up_prior_c);
+
+  // The segments of the last call's winning hypothesis, full-resolution pixels (for plots).
+  const std::vector<cv::Vec4f>& inlierSegments() const { return inlier_segments_; }
+
+ private:
+  struct Plane {
+    Eigen::Vector3d n;
+    double w;
+    cv::Vec4f seg;
+  };
+  // up = the smallest eigenvector of the weighted scatter of the planes with |n . up| < bound;
+  // returns false when fewer than 3 planes qualify.
+  bool refine(double bound, Eigen::Vector3d* up, int* inliers, double* sigma) const;
+
+  VerticalOptions options_;
+  StereoCamera camera_;
+  cv::Ptr<cv::LineSegmentDetector> lsd_;
+  cv::Mat small_;
+  std::vector<cv::Vec4f> segments_;
+  std::vector<Plane> planes_;
+  std::vector<cv::Vec4f> inlier_segments_;
+};
+
+}  // namespace sunvo::vertical
