@@ -4,6 +4,7 @@
 
 #include <vector>
 
+#include "../support/kitti_first_frames.hpp"
 #include "../support/synthetic_stereo.hpp"
 
 namespace sunvo::pipeline {
@@ -108,6 +109,69 @@ TEST_F(SunAidedOdometryTest, PureVoIsTheBackEndAlone) {
     ASSERT_TRUE(r);
     EXPECT_TRUE(r->T_w_c.isApprox(poses_[static_cast<std::size_t>(k)], 1e-12)) << k;
   }
+}
+
+TEST_F(SunAidedOdometryTest, AnUpCueFixesTheTiltNotTheHeading) {
+  // Start 2 deg off in roll (about the camera's z, a tilt) and 2 deg off in heading (about up).
+  // With feature input there are no images: the image cue is inactive, and "up" comes from
+  // another source (here the truth, 0.3 deg sigma) through addVertical on the every-n frames.
+  const Eigen::Vector3d up_w = -Eigen::Vector3d::UnitY();
+  T_w_c0_.linear() = expSO3(2.0 * kDeg * Eigen::Vector3d::UnitZ() + 2.0 * kDeg * up_w);
+  options_.use_sun = false;
+  options_.vertical.enabled = true;
+  SunAidedOdometry odo;
+  ASSERT_TRUE(odo.init(options_, camera_, T_w_c0_, OdometryInput::kFeatures).isOk());
+  EXPECT_FALSE(odo.verticalActive());
+  for (int k = 0; k < kFrames; ++k) {
+    const auto seq = static_cast<std::uint64_t>(k);
+    EXPECT_EQ(odo.isSunFrame(seq), false);
+    if (odo.isCueFrame(seq)) {
+      sunfusion::SunObservation obs;
+      obs.measurement.sequence = seq;
+      obs.measurement.sun_c = T_w_k_[static_cast<std::size_t>(k)].linear().transpose() * up_w;
+      obs.measurement.sigma = 0.3 * kDeg;
+      obs.sun_w = up_w;
+      odo.addVertical(obs);
+    }
+    ASSERT_TRUE(odo.process(frames_[static_cast<std::size_t>(k)]));
+  }
+  EXPECT_EQ(odo.verticalCounters().accepted, 11u);
+  EXPECT_EQ(odo.sunCounters().total(), 0u);
+  // C_w_true = Exp(e) C_w_est: split e into tilt and heading.
+  const Eigen::Vector3d e =
+      logSO3(T_w_k_.back().linear() * odo.T_w_c().linear().transpose()) / kDeg;
+  const double heading = e.dot(up_w);
+  const double tilt = (e - heading * up_w).norm();
+  EXPECT_LT(tilt, 0.5) << "tilt " << tilt << " deg";
+  EXPECT_GT(std::abs(heading), 1.8) << "heading " << heading << " deg";
+}
+
+TEST(SunAidedOdometryImages, TheImageCueMeasuresUpOnRealFrames) {
+  // The 11 real KITTI frames, a cue on every frame after the first: each call answers (the
+  // street has poles and facades), nothing is refused as bad input, and no pose is NaN.
+  auto data = testing::loadKittiFirstFrames();
+  ASSERT_TRUE(data) << data.status().toString();
+  SunAidedOptions options;
+  options.use_sun = false;
+  options.every_n_frames = 1;
+  options.vertical.enabled = true;
+  options.fusion.world_up = -Eigen::Vector3d::UnitY();
+  options.pipeline.vo.window.max_solver_time_in_seconds = 10.0;
+  SunAidedOdometry odo;
+  ASSERT_TRUE(odo.init(options, data->camera, Isometry3::Identity()).isOk());
+  EXPECT_TRUE(odo.verticalActive());
+  for (const StereoFrame& f : data->frames) {
+    auto r = odo.process(f);
+    ASSERT_TRUE(r) << r.status().toString();
+    ASSERT_TRUE(allFinite(r->vo.T_w_c));
+  }
+  const auto n = static_cast<std::uint64_t>(data->frames.size());
+  EXPECT_EQ(odo.verticalStats().calls, n - 1);
+  EXPECT_EQ(odo.verticalStats().errors, 0u);
+  EXPECT_GE(odo.verticalStats().valid, n - 3);
+  EXPECT_EQ(odo.verticalCounters().total(), odo.verticalStats().valid);
+  EXPECT_EQ(odo.sunCounters().total(), 0u);
+  EXPECT_TRUE(odo.attitudeCovariance().allFinite());
 }
 
 TEST_F(SunAidedOdometryTest, ScheduleInputsAndOptionsAreChecked) {

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <vector>
 
+#include "sunvo/core/geometry.hpp"
+
 namespace sunvo::sunfusion {
 namespace {
 
@@ -79,10 +81,59 @@ TEST(SimulatedSunSource, AzimuthOnlyLiesInThePlaneAndIsReproducible) {
   }
 }
 
+TEST(SimulatedVerticalSource, ErrorsDropoutsOutliersAndBiasAsModelled) {
+  // Truth: a camera rolled by 3 deg. The pitch error (about camera x) and roll error (about z) of
+  // each measurement: mean = bias, std = sigma; 8 deg outliers; dropouts.
+  VerticalErrorModel model;
+  model.sigma_deg = 1.0;
+  model.roll_bias_deg = 0.5;
+  model.outlier_share = 0.1;
+  model.dropout_share = 0.3;
+  model.reported_sigma_deg = 1.5;
+  SimulatedVerticalSource source(model), twin(model);
+  const Eigen::Vector3d truth =
+      expSO3(Eigen::Vector3d(0.0, 0.0, 3.0 * kDeg)) * Eigen::Vector3d(0.0, -1.0, 0.0);
+  int dropped = 0, outliers = 0, n = 0;
+  double sum_roll = 0.0, sum_roll2 = 0.0, sum_pitch2 = 0.0;
+  for (int i = 0; i < 20000; ++i) {
+    auto m = source.measure(7, 0, truth);
+    auto m2 = twin.measure(7, 0, truth);
+    ASSERT_EQ(m.has_value(), m2.has_value());
+    if (!m) {
+      ++dropped;
+      continue;
+    }
+    EXPECT_EQ(m->sun_c, m2->sun_c);
+    EXPECT_EQ(m->kind, SunMeasurementKind::kFull3d);
+    EXPECT_NEAR(m->sigma, 1.5 * kDeg, 1e-15);
+    EXPECT_NEAR(m->sun_c.norm(), 1.0, 1e-12);
+    const Eigen::Vector3d e = truth.cross(m->sun_c);  // small rotation truth -> measurement
+    const double angle = std::asin(std::min(1.0, e.norm()));
+    if (std::abs(angle - 8.0 * kDeg) < 1e-9) {
+      ++outliers;
+      continue;
+    }
+    ++n;
+    sum_roll += e.z();
+    sum_roll2 += e.z() * e.z();
+    sum_pitch2 += e.x() * e.x();
+  }
+  EXPECT_NEAR(dropped / 20000.0, 0.3, 0.01);
+  EXPECT_NEAR(outliers / 14000.0, 0.1, 0.01);
+  const double mean_roll = sum_roll / n;
+  EXPECT_NEAR(mean_roll / kDeg, 0.5, 0.03);
+  EXPECT_NEAR(std::sqrt(sum_roll2 / n - mean_roll * mean_roll) / kDeg, 1.0, 0.03);
+  EXPECT_NEAR(std::sqrt(sum_pitch2 / n) / kDeg, 1.0, 0.03);
+}
+
 TEST(SimulatedSunSource, ValidationNamesTheKey) {
   SunErrorModel model;
   model.flip_share = 2.0;
   EXPECT_NE(model.validate().message().find("sun_error.flip_share"), std::string::npos);
+  VerticalErrorModel vertical;
+  vertical.reported_sigma_deg = 0.0;
+  EXPECT_NE(vertical.validate().message().find("vertical_error.reported_sigma_deg"),
+            std::string::npos);
 }
 
 }  // namespace

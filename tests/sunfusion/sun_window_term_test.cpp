@@ -300,6 +300,63 @@ TEST_F(SunWindowTermTest, PersistenceRuleIgnoresZeroMeanNoiseAndOutliers) {
   EXPECT_LT(logSO3(dC).norm() / kDeg, 0.5);
 }
 
+// Windows that all start from the same 2 deg roll error (a tilt: this world's up is -y), each
+// with a precise "up" measurement on the vertical channel.
+void runStandingTiltError(SunWindowTermTest* t, backend::BundleWindow* window,
+                          const SunFusionOptions& opt, SunWindowTerm* term,
+                          const Isometry3& T_k_b_true,
+                          const std::vector<backend::WindowObservation>& obs_b,
+                          const std::vector<backend::WindowObservation>& obs_k) {
+  (void)t;
+  Isometry3 T_w_b_est = Isometry3::Identity();
+  T_w_b_est.linear() = expSO3(Eigen::Vector3d(0.0, 0.0, 2.0 * kDeg));
+  ASSERT_TRUE(term->init(opt).isOk());
+  const Eigen::Vector3d up_w(0.0, -1.0, 0.0);
+  for (std::uint64_t k = 1; k <= 41; k += 2) {
+    window->reset(T_w_b_est);
+    term->attach(*window);
+    SunObservation up;
+    up.sun_w = up_w;
+    up.measurement.sequence = k;
+    up.measurement.sigma = 0.01;
+    up.measurement.sun_c = T_k_b_true.linear() * up_w;  // truth: C_b_w = I
+    term->addVertical(up);
+    const TimeNs time = static_cast<TimeNs>(k) * 100'000'000;
+    ASSERT_TRUE(window->addFrame(k - 1, time - 100'000'000, obs_b, Isometry3::Identity()).isOk());
+    ASSERT_TRUE(window->addFrame(k, time, obs_k, T_k_b_true).isOk());
+    ASSERT_TRUE(window->solve());
+  }
+}
+
+TEST_F(SunWindowTermTest, VerticalChannelIsCountedApartAndSplitsTheWalkByGravity) {
+  SunFusionOptions opt = baseAttitudeOptions();
+  opt.initial_attitude_sigma_deg = 0.1;
+  opt.innovation_gate_chi2 = 0.0;
+  opt.max_drift_deg_per_frame = 0.5;
+  ASSERT_TRUE(opt.split_drift_by_gravity);
+  SunWindowTerm split;
+  runStandingTiltError(this, &window_, opt, &split, T_k_b_true_, obs_b_, obs_k_);
+  EXPECT_EQ(split.counters().total(), 0u);
+  EXPECT_EQ(split.verticalCounters().accepted, 21u);
+  // The standing tilt raises the tilt's walk; the heading's, which only the sun's measurements
+  // move, stays at its start.
+  EXPECT_GT(split.tiltDriftDegPerFrame(), 0.2);
+  EXPECT_EQ(split.headingDriftDegPerFrame(), opt.attitude_drift_deg_per_frame);
+  EXPECT_EQ(split.driftDegPerFrame(), split.tiltDriftDegPerFrame());
+  // The last window's newest frame: most of its tilt is corrected (0.62 deg of 2 left, measured
+  // 2026-11-26; each window starts from the same error, so this is one window's share).
+  const Eigen::Vector3d e =
+      logSO3(T_k_b_true_.linear().transpose() * window_.T_w_newest().linear().transpose());
+  EXPECT_LT(std::hypot(e.x(), e.z()) / kDeg, 1.0);
+
+  // One walk for all axes: the heading's grows with the tilt's.
+  opt.split_drift_by_gravity = false;
+  SunWindowTerm joint;
+  runStandingTiltError(this, &window_, opt, &joint, T_k_b_true_, obs_b_, obs_k_);
+  EXPECT_GT(joint.headingDriftDegPerFrame(), 0.2);
+  EXPECT_EQ(joint.headingDriftDegPerFrame(), joint.tiltDriftDegPerFrame());
+}
+
 TEST_F(SunWindowTermTest, EvidenceRuleWidensPOnlyWhereTheErrorStandsOutOfTheNoise) {
   // A 0.1 deg prior against a standing 2 deg base error. Precise measurements (0.57 deg) evidence
   // the error within two windows: P must be widened to cover it. Imprecise ones (17 deg) evidence

@@ -355,6 +355,30 @@ Status EvaluationOptions::validate() const {
   return Status::ok();
 }
 
+Expected<TiltMetrics> computeTilt(const std::vector<Isometry3>& T_w_c_gt,
+                                  const std::vector<Isometry3>& T_w_c_est,
+                                  const Eigen::Vector3d& up_w) {
+  SUNVO_RETURN_IF_ERROR(validateTrajectories(T_w_c_gt, T_w_c_est));
+  if (!up_w.allFinite() || std::abs(up_w.norm() - 1.0) > 1e-6) {
+    return invalidArgument("computeTilt: up_w must be a unit vector");
+  }
+  TiltMetrics out;
+  double tilt2 = 0.0, heading2 = 0.0;
+  for (std::size_t k = 0; k < T_w_c_gt.size(); ++k) {
+    const Eigen::Vector3d e = logSO3(T_w_c_gt[k].linear() * T_w_c_est[k].linear().transpose());
+    const double heading = std::abs(e.dot(up_w));
+    const double tilt = (e - e.dot(up_w) * up_w).norm();
+    tilt2 += tilt * tilt;
+    heading2 += heading * heading;
+    out.tilt_final_rad = tilt;
+    out.heading_final_rad = heading;
+  }
+  const double n = static_cast<double>(T_w_c_gt.size());
+  out.tilt_rms_rad = std::sqrt(tilt2 / n);
+  out.heading_rms_rad = std::sqrt(heading2 / n);
+  return out;
+}
+
 Expected<Evaluation> evaluate(const std::vector<Isometry3>& T_w_c_gt,
                               const std::vector<Isometry3>& T_w_c_est,
                               const EvaluationOptions& options) {

@@ -1,10 +1,13 @@
 #include "sunvo/pipeline/sun_aided_odometry.hpp"
 
+#include <chrono>
+
 namespace sunvo::pipeline {
 
 Status SunAidedOptions::validate() const {
   SUNVO_RETURN_IF_ERROR(pipeline.validate());
   SUNVO_RETURN_IF_ERROR(fusion.validate());
+  SUNVO_RETURN_IF_ERROR(vertical.estimator.validate());
   if (every_n_frames < 1 || every_n_frames > 1000) {
     return invalidArgument("every_n_frames: " + std::to_string(every_n_frames) +
                            " is outside [1, 1000]");
@@ -24,7 +27,10 @@ Status SunAidedOdometry::init(const SunAidedOptions& options, const StereoCamera
     SUNVO_RETURN_IF_ERROR(tracks_.init(options.pipeline.vo, camera, T_w_c0));
   }
   backend::BundleWindow& window = backEnd().window();
-  if (options.use_sun) {
+  vertical_active_ = options.vertical.enabled && input == OdometryInput::kImages;
+  vertical_stats_ = VerticalStats{};
+  if (vertical_active_) SUNVO_RETURN_IF_ERROR(vertical_.init(options.vertical.estimator, camera));
+  if (options.use_sun || options.vertical.enabled) {
     SUNVO_RETURN_IF_ERROR(sun_term_.init(options.fusion));
     sun_term_.attach(window);
   } else {
@@ -43,12 +49,45 @@ void SunAidedOdometry::addSun(const sunfusion::SunObservation& observation) {
   sun_term_.addObservation(observation);
 }
 
+void SunAidedOdometry::addVertical(const sunfusion::SunObservation& observation) {
+  if (!initialized_ || !options_.vertical.enabled) return;
+  sun_term_.addVertical(observation);
+}
+
 Expected<FrameResult> SunAidedOdometry::process(const StereoFrame& frame) {
   if (!initialized_ || input_ != OdometryInput::kImages) {
     return failedPrecondition("SunAidedOdometry::process(StereoFrame): not initialised for images");
   }
+  double vertical_ms = 0.0;
+  if (vertical_active_ && isCueFrame(frame.sequence)) {
+    const auto t0 = std::chrono::steady_clock::now();
+    // The prior: "up" in the last frame's camera (one frame of motion away from this one).
+    const Eigen::Vector3d up_w = options_.fusion.world_up;
+    const Eigen::Vector3d prior_c = T_w_c_.linear().transpose() * up_w;
+    ++vertical_stats_.calls;
+    Expected<vertical::VerticalMeasurement> m = vertical_.estimate(frame.left, prior_c);
+    if (!m) {
+      ++vertical_stats_.errors;  // the image is refused; VO goes on without the cue
+    } else if (m->valid) {
+      ++vertical_stats_.valid;
+      sunfusion::SunObservation o;
+      o.measurement.sequence = frame.sequence;
+      o.measurement.time_ns = frame.trigger_time_ns;
+      o.measurement.kind = sunfusion::SunMeasurementKind::kFull3d;
+      o.measurement.sun_c = m->up_c;
+      o.measurement.sigma = m->sigma_rad;
+      o.sun_w = up_w;
+      sun_term_.addVertical(o);
+    }
+    vertical_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  }
   Expected<FrameResult> r = vo_.process(frame);
-  if (r) T_w_c_ = r->vo.T_w_c;
+  if (r) {
+    T_w_c_ = r->vo.T_w_c;
+    r->times.vertical_ms = vertical_ms;
+    r->times.total_ms += vertical_ms;
+  }
   return r;
 }
 

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "sunvo/core/geometry.hpp"
+
 namespace sunvo::sunfusion {
 namespace {
 constexpr double kDeg = M_PI / 180.0;
@@ -29,6 +31,55 @@ Status SunErrorModel::validate() const {
     return invalidArgument("sun_error.reported_sigma out of range (0, 2]");
   }
   return Status::ok();
+}
+
+Status VerticalErrorModel::validate() const {
+  if (!(sigma_deg >= 0.0 && sigma_deg <= 30.0)) {
+    return invalidArgument("vertical_error.sigma_deg out of range [0, 30]");
+  }
+  if (!(std::abs(pitch_bias_deg) <= 10.0) || !(std::abs(roll_bias_deg) <= 10.0)) {
+    return invalidArgument("vertical_error.pitch_bias_deg / roll_bias_deg out of range [-10, 10]");
+  }
+  if (!inUnit(outlier_share)) {
+    return invalidArgument("vertical_error.outlier_share out of range [0, 1]");
+  }
+  if (!(outlier_deg >= 0.0 && outlier_deg <= 90.0)) {
+    return invalidArgument("vertical_error.outlier_deg out of range [0, 90]");
+  }
+  if (!inUnit(dropout_share)) {
+    return invalidArgument("vertical_error.dropout_share out of range [0, 1]");
+  }
+  if (!(reported_sigma_deg > 0.0 && reported_sigma_deg <= 30.0)) {
+    return invalidArgument("vertical_error.reported_sigma_deg out of range (0, 30]");
+  }
+  return Status::ok();
+}
+
+std::optional<SunMeasurement> SimulatedVerticalSource::measure(std::uint64_t sequence,
+                                                               TimeNs time_ns,
+                                                               const Eigen::Vector3d& true_up_c) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  const double u_drop = unit(rng_), u_out = unit(rng_);
+  const Eigen::Vector3d n(normal(rng_), normal(rng_), normal(rng_));
+  const Eigen::Vector3d axis(normal(rng_), normal(rng_), normal(rng_));
+  if (u_drop < model_.dropout_share) return std::nullopt;
+  Eigen::Vector3d rot;
+  const Eigen::Vector3d t = true_up_c.normalized();
+  const Eigen::Vector3d across = axis - axis.dot(t) * t;  // turns t by the full angle
+  if (u_out < model_.outlier_share && across.norm() > 0.0) {
+    rot = across.normalized() * model_.outlier_deg * kDeg;
+  } else {
+    rot = Eigen::Vector3d(model_.pitch_bias_deg, 0.0, model_.roll_bias_deg) * kDeg +
+          n * model_.sigma_deg * kDeg;
+  }
+  SunMeasurement m;
+  m.time_ns = time_ns;
+  m.sequence = sequence;
+  m.kind = SunMeasurementKind::kFull3d;
+  m.sigma = model_.reported_sigma_deg * kDeg;
+  m.sun_c = (expSO3(rot) * t).normalized();
+  return m;
 }
 
 Eigen::Vector3d sunFromAzimuthZenith(double azimuth_rad, double zenith_rad) {

@@ -55,6 +55,9 @@ double chiSquareQuantile(double p, int dof) {
 
 Status SunFusionOptions::validate() const {
   SUNVO_RETURN_IF_ERROR(gate.validate());
+  if (const Status s = vertical_gate.validate(); !s.isOk()) {
+    return invalidArgument("fusion.vertical_gate: " + s.message());
+  }
   if (!world_up.allFinite() || std::abs(world_up.norm() - 1.0) > 1e-6) {
     return invalidArgument("fusion.world_up must be a unit vector");
   }
@@ -115,6 +118,7 @@ Status SunWindowTerm::init(const SunFusionOptions& options) {
   for (auto& p : pending_) p = Pending{};
   used_.fill(false);
   counters_ = GateCounters{};
+  vertical_counters_ = GateCounters{};
   last_decision_.reset();
   delta_ = {0.0, 0.0, 0.0};
   const double s0 = options.initial_attitude_sigma_deg * kDeg;
@@ -122,8 +126,11 @@ Status SunWindowTerm::init(const SunFusionOptions& options) {
   drift_deg_per_frame_ = options.drift_adaptation == DriftAdaptation::kEvidence
                              ? options.min_drift_deg_per_frame
                              : options.attitude_drift_deg_per_frame;
+  heading_drift_deg_per_frame_ = drift_deg_per_frame_;
   persistence_g_.setZero();
   persistence_I_.setZero();
+  sun_g_.setZero();
+  sun_I_.setZero();
   persistence_T_ = 0.0;
   persistence_bound_[0] = 0.0;
   for (int dof = 1; dof <= 3; ++dof) {
@@ -145,7 +152,17 @@ void SunWindowTerm::attach(backend::BundleWindow& window) {
 }
 
 void SunWindowTerm::addObservation(const SunObservation& observation) {
-  const std::size_t slot = observation.measurement.sequence % pending_.size();
+  add(observation, 0);
+}
+
+void SunWindowTerm::addVertical(const SunObservation& observation) {
+  add(observation, 1);
+}
+
+void SunWindowTerm::add(const SunObservation& observation, int channel) {
+  const std::size_t slot =
+      (observation.measurement.sequence % backend::BundleWindow::kMaxWindowSize) * kChannels +
+      static_cast<std::size_t>(channel);
   pending_[slot] = Pending{};
   pending_[slot].obs = observation;
   used_[slot] = true;
@@ -164,8 +181,11 @@ Status SunWindowTerm::onSolve(backend::BundleWindow& window) {
   // Prior of this solve's base correction delta_b = C_b_w dtheta_w: N(0, C_b_w P_theta C_w_b).
   const Eigen::Matrix3d C_b_w = window.T_w_b().linear().transpose();
   const Eigen::Matrix3d P_b = C_b_w * P_ * C_b_w.transpose();
-  for (int s = 1; s < window.size(); ++s) {
-    const std::size_t ring = window.sequence(s) % pending_.size();
+  for (int i = kChannels; i < window.size() * kChannels; ++i) {
+    const int s = i / kChannels, channel = i % kChannels;
+    const std::size_t ring =
+        (window.sequence(s) % backend::BundleWindow::kMaxWindowSize) * kChannels +
+        static_cast<std::size_t>(channel);
     if (!used_[ring] || pending_[ring].obs.measurement.sequence != window.sequence(s)) continue;
     Pending& p = pending_[ring];
     const Eigen::Vector3d sun_b = C_b_w * p.obs.sun_w;
@@ -173,7 +193,8 @@ Status SunWindowTerm::onSolve(backend::BundleWindow& window) {
     if (!p.decided) {
       const Eigen::Vector3d predicted_c = window.T_k_b(s).linear() * sun_b;
       const double up = p.obs.sun_w.dot(options_.world_up);
-      GateResult r = gateSunMeasurement(options_.gate, predicted_c, up, p.obs.measurement);
+      GateResult r = gateSunMeasurement(channel == 0 ? options_.gate : options_.vertical_gate,
+                                        predicted_c, up, p.obs.measurement);
       if (r == GateResult::kAccepted && estimate) {
         p.cost = makeSunCost(sun_b, p.obs.measurement, true);
         cost_built = true;
@@ -187,11 +208,15 @@ Status SunWindowTerm::onSolve(backend::BundleWindow& window) {
                    inn.move_b.norm() > options_.max_correction_deg * kDeg) {
           r = GateResult::kRejectedCorrection;
         } else {
-          adaptDrift(inn, window.T_w_b().linear());
+          adaptDrift(inn, window.T_w_b().linear(), channel);
         }
       }
-      counters_.count(r);
-      last_decision_ = r;
+      if (channel == 0) {
+        counters_.count(r);
+        last_decision_ = r;
+      } else {
+        vertical_counters_.count(r);
+      }
       p.decided = true;
       p.accepted = r == GateResult::kAccepted;
     }
@@ -262,9 +287,22 @@ void SunWindowTerm::onSolved(backend::BundleWindow& window) {
   }
 }
 
+bool SunWindowTerm::splitByGravity() const {
+  return options_.split_drift_by_gravity &&
+         options_.drift_adaptation == DriftAdaptation::kPersistence;
+}
+
 void SunWindowTerm::propagate(double frames) {
   const double q = drift_deg_per_frame_ * kDeg;
-  P_ += Eigen::Matrix3d::Identity() * q * q * frames;
+  if (!splitByGravity() || heading_drift_deg_per_frame_ == drift_deg_per_frame_) {
+    P_ += Eigen::Matrix3d::Identity() * q * q * frames;
+    return;
+  }
+  // Tilt (the plane normal to the world's up) and heading (about it) walk apart.
+  const Eigen::Vector3d& u = options_.world_up;
+  const double qh = heading_drift_deg_per_frame_ * kDeg;
+  const Eigen::Matrix3d uu = u * u.transpose();
+  P_ += (q * q * (Eigen::Matrix3d::Identity() - uu) + qh * qh * uu) * frames;
 }
 
 bool SunWindowTerm::evaluateAt(const ceres::CostFunction& cost, const Isometry3& T_k_b,
@@ -279,7 +317,7 @@ bool SunWindowTerm::evaluateAt(const ceres::CostFunction& cost, const Isometry3&
          J_d->topRows(*m).allFinite();
 }
 
-void SunWindowTerm::adaptDrift(const Innovation& inn, const Eigen::Matrix3d& C_w_b) {
+void SunWindowTerm::adaptDrift(const Innovation& inn, const Eigen::Matrix3d& C_w_b, int channel) {
   const int m = inn.dof;
   double step = 0.0;
   switch (options_.drift_adaptation) {
@@ -293,7 +331,7 @@ void SunWindowTerm::adaptDrift(const Innovation& inn, const Eigen::Matrix3d& C_w
       break;
     }
     case DriftAdaptation::kEvidence:
-      accumulate(inn, C_w_b);
+      accumulate(inn, C_w_b, &persistence_I_, &persistence_g_);
       inflateToEvidence();
       return;
     case DriftAdaptation::kPersistence: {
@@ -304,33 +342,60 @@ void SunWindowTerm::adaptDrift(const Innovation& inn, const Eigen::Matrix3d& C_w
       // T = g^T I^+ g with rank(I) dof when dtheta_w = 0 (noise only). The sums forget by
       // persistence_forgetting per measurement, so T weighs the recent drift; a Huber weight
       // caps an outlier's pull at persistence_huber sigmas per row.
-      accumulate(inn, C_w_b);
-      // Pseudo-inverse: one sun direction never informs the rotation about itself, and directions
-      // with less than 1e-3 of the strongest information count as unobserved (rank drops).
-      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(persistence_I_);
-      const double floor = 1e-3 * std::max(eig.eigenvalues().maxCoeff(), 1e-300);
-      double T = 0.0;
+      accumulate(inn, C_w_b, &persistence_I_, &persistence_g_);
       std::size_t rank = 0;
-      for (int i = 0; i < 3; ++i) {
-        const double l = eig.eigenvalues()(i);
-        if (l > floor) {
-          const double proj = eig.eigenvectors().col(i).dot(persistence_g_);
-          T += proj * proj / l;
-          ++rank;
+      persistence_T_ = persistenceStatistic(persistence_I_, persistence_g_, &rank);
+      step = rank > 0 && persistence_T_ > persistence_bound_[rank]
+                 ? options_.persistence_step_up
+                 : -options_.persistence_step_down;
+      if (splitByGravity()) {
+        // The tilt's walk steps on every measurement's test (all channels); the heading's only on
+        // the sun's, from sums of the sun's measurements alone: an "up" never sees the heading.
+        // Without vertical measurements both sums, tests and walks are the same.
+        drift_deg_per_frame_ = clampDrift(drift_deg_per_frame_ * std::exp(step));
+        if (channel == 0) {
+          accumulate(inn, C_w_b, &sun_I_, &sun_g_);
+          std::size_t sun_rank = 0;
+          const double T = persistenceStatistic(sun_I_, sun_g_, &sun_rank);
+          const double step_h = sun_rank > 0 && T > persistence_bound_[sun_rank]
+                                    ? options_.persistence_step_up
+                                    : -options_.persistence_step_down;
+          heading_drift_deg_per_frame_ =
+              clampDrift(heading_drift_deg_per_frame_ * std::exp(step_h));
         }
+        return;
       }
-      persistence_T_ = T;
-      step = rank > 0 && T > persistence_bound_[rank] ? options_.persistence_step_up
-                                                      : -options_.persistence_step_down;
       break;
     }
   }
-  drift_deg_per_frame_ *= std::exp(step);
-  drift_deg_per_frame_ = std::clamp(drift_deg_per_frame_, options_.min_drift_deg_per_frame,
-                                    options_.max_drift_deg_per_frame);
+  drift_deg_per_frame_ = clampDrift(drift_deg_per_frame_ * std::exp(step));
 }
 
-void SunWindowTerm::accumulate(const Innovation& inn, const Eigen::Matrix3d& C_w_b) {
+double SunWindowTerm::clampDrift(double q) const {
+  return std::clamp(q, options_.min_drift_deg_per_frame, options_.max_drift_deg_per_frame);
+}
+
+double SunWindowTerm::persistenceStatistic(const Eigen::Matrix3d& I, const Eigen::Vector3d& g,
+                                           std::size_t* rank) {
+  // Pseudo-inverse: one sun direction never informs the rotation about itself, and directions
+  // with less than 1e-3 of the strongest information count as unobserved (rank drops).
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(I);
+  const double floor = 1e-3 * std::max(eig.eigenvalues().maxCoeff(), 1e-300);
+  double T = 0.0;
+  *rank = 0;
+  for (int i = 0; i < 3; ++i) {
+    const double l = eig.eigenvalues()(i);
+    if (l > floor) {
+      const double proj = eig.eigenvectors().col(i).dot(g);
+      T += proj * proj / l;
+      ++*rank;
+    }
+  }
+  return T;
+}
+
+void SunWindowTerm::accumulate(const Innovation& inn, const Eigen::Matrix3d& C_w_b,
+                               Eigen::Matrix3d* I, Eigen::Vector3d* g) const {
   // Fixed-size, with the rows past m zero (no heap allocation).
   const int m = inn.dof;
   Eigen::Matrix3d J = inn.J;
@@ -344,8 +409,8 @@ void SunWindowTerm::accumulate(const Innovation& inn, const Eigen::Matrix3d& C_w
   const double lambda = options_.drift_adaptation == DriftAdaptation::kEvidence
                             ? options_.evidence_forgetting
                             : options_.persistence_forgetting;
-  persistence_g_ = lambda * persistence_g_ + H.transpose() * (w * r);
-  persistence_I_ = lambda * persistence_I_ + H.transpose() * H;
+  *g = lambda * *g + H.transpose() * (w * r);
+  *I = lambda * *I + H.transpose() * H;
 }
 
 void SunWindowTerm::inflateToEvidence() {

@@ -19,6 +19,7 @@ Status ExperimentOptions::validate() const {
     return invalidArgument("experiment.every_n_frames out of range [1, 1000]");
   }
   if (max_frames < 0) return invalidArgument("experiment.max_frames must be >= 0");
+  if (vertical) SUNVO_RETURN_IF_ERROR(vertical->validate());
   return Status::ok();
 }
 
@@ -43,6 +44,11 @@ Expected<RunResult> runRoute(const Route& route, const std::optional<SunSourceSp
     SUNVO_RETURN_IF_ERROR(spec->model.validate());
     source.emplace(spec->model);
   }
+  std::optional<sunfusion::SimulatedVerticalSource> vertical;
+  if (options.vertical) {
+    sao.vertical.enabled = true;
+    vertical.emplace(*options.vertical);
+  }
   pipeline::SunAidedOdometry odometry;
   SUNVO_RETURN_IF_ERROR(
       odometry.init(sao, route.camera, route.T_w_c_gt[0], pipeline::OdometryInput::kFeatures));
@@ -52,6 +58,7 @@ Expected<RunResult> runRoute(const Route& route, const std::optional<SunSourceSp
   FrameFeatures corrected;
   RunResult result;
   result.name = spec ? spec->name : "Pure VO";
+  if (vertical) result.name = spec ? result.name + " +vertical-like" : "VO+vertical-like";
   result.T_w_c.reserve(n);
   std::vector<double> ms;
   ms.reserve(n);
@@ -60,6 +67,11 @@ Expected<RunResult> runRoute(const Route& route, const std::optional<SunSourceSp
     if (source && odometry.isSunFrame(frame.sequence)) {
       auto m = source->measure(frame.sequence, frame.time_ns, route.sun_c_gt[k]);
       if (m) odometry.addSun({*m, route.sun_w[k]});
+    }
+    if (vertical && odometry.isCueFrame(frame.sequence)) {
+      const Eigen::Vector3d up_c = route.T_w_c_gt[k].linear().transpose() * route.world_up;
+      auto m = vertical->measure(frame.sequence, frame.time_ns, up_c);
+      if (m) odometry.addVertical({*m, route.world_up});
     }
     const auto t0 = std::chrono::steady_clock::now();
     const FrameFeatures* in = &frame;
@@ -76,6 +88,7 @@ Expected<RunResult> runRoute(const Route& route, const std::optional<SunSourceSp
     if (observer) observer(k, odometry);
   }
   result.gate = odometry.sunCounters();
+  result.vertical_gate = odometry.verticalCounters();
   result.selfcal_pitch_mrad = selfcal.state()[0] * 1e3;
   result.selfcal_roll_mrad = selfcal.state()[1] * 1e3;
   result.selfcal_resets = selfcal.resets();
@@ -88,6 +101,9 @@ Expected<RunResult> runRoute(const Route& route, const std::optional<SunSourceSp
   auto ev = metrics::evaluate(gt, result.T_w_c, eval_opt);
   if (!ev) return ev.status();
   result.evaluation = *ev;
+  auto tilt = metrics::computeTilt(gt, result.T_w_c, route.world_up);
+  if (!tilt) return tilt.status();
+  result.tilt = *tilt;
   return result;
 }
 

@@ -89,10 +89,33 @@ int main(int argc, char** argv) {
                  "attitude is estimated), paper (held fixed, as the paper did)");
   app.add_flag("--fixed-drift", fixed_drift, "keep the random walk at --drift-deg");
   sunvo::cli::addRotationRatePriorOptions(app, options.vo.window);
+  bool vertical = false;
+  // The vertical-like source (docs/vertical.md): 1 deg per axis, as the cue's spread on real
+  // KITTI frames; 10 % of 8 deg outliers; half the cue frames without an answer.
+  sunvo::sunfusion::VerticalErrorModel vertical_model;
+  vertical_model.outlier_share = 0.1;
+  vertical_model.dropout_share = 0.5;
+  app.add_flag("--vertical", vertical,
+               "also every run with a simulated \"up\" cue on the every-n frames (the vertical "
+               "vanishing point's error model, docs/vertical.md)");
+  app.add_option("--vertical-sigma-deg", vertical_model.sigma_deg, "its per-axis error, deg")
+      ->check(CLI::Range(0.0, 30.0));
+  app.add_option("--vertical-reported-sigma-deg", vertical_model.reported_sigma_deg,
+                 "the sigma written into its measurements, deg")
+      ->check(CLI::Range(0.0, 30.0));
+  app.add_option("--vertical-outliers", vertical_model.outlier_share,
+                 "share of its measurements turned by 8 deg instead")
+      ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--vertical-dropout", vertical_model.dropout_share,
+                 "share of its frames without a measurement")
+      ->check(CLI::Range(0.0, 1.0));
   app.add_flag("--self-calib", self_calib,
                "online stereo self-calibration of the right camera before the odometry");
   app.add_option("--drift-rule", drift_rule, "how the random walk adapts")
       ->check(CLI::IsMember({"persistence", "median", "fixed", "evidence"}));
+  app.add_flag("!--no-split-drift", options.fusion.split_drift_by_gravity,
+               "persistence rule: one random walk for all axes (before 2026-11-26), not one for "
+               "the tilt and one for the heading");
   app.add_option("--evidence-sigmas", evidence_sigmas,
                  "evidence rule: sigmas an error must reach before P covers it")
       ->check(CLI::Range(0.0, 100.0));
@@ -161,10 +184,11 @@ int main(int argc, char** argv) {
     return sunvo::cli::kExitUsage;
   }
   const auto sources = sunvo::experiment::defaultSunSources(static_cast<std::uint32_t>(seed));
+  vertical_model.seed = static_cast<std::uint32_t>(seed) + 10;  // the sun sources use seed..seed+3
 
   std::string summary =
       "| route | source | final drift [m] | change | rot. ARMSE [1e-3] | change | "
-      "sun accepted / offered |\n|---|---|---|---|---|---|---|\n";
+      "sun accepted / offered | tilt RMS [deg] | change |\n|---|---|---|---|---|---|---|---|---|\n";
   for (const std::string& route_spec : splitComma(routes_arg)) {
     const std::string id = routeId(route_spec);
     sunvo::experiment::SimulatedRouteOptions sim;
@@ -176,18 +200,26 @@ int main(int argc, char** argv) {
                  route->source.c_str());
     std::vector<RunResult> runs;
     // Pure VO, then every source in every form (the paper's columns marked when both are shown).
-    std::vector<std::pair<std::optional<sunvo::experiment::SunSourceSpec>, bool>> plan = {
-        {std::nullopt, false}};
+    // With --vertical, each run once more with the simulated "up" cue.
+    struct Planned {
+      std::optional<sunvo::experiment::SunSourceSpec> spec;
+      bool paper = false;
+      bool vertical = false;
+    };
+    std::vector<Planned> plan = {{std::nullopt, false, false}};
+    if (vertical) plan.push_back({std::nullopt, false, true});
     for (const auto& src : sources) {
       for (const std::string& f : forms) {
         sunvo::experiment::SunSourceSpec spec = src;
         if (f == "paper" && forms.size() > 1) spec.name += " paper form";
-        plan.push_back({spec, f == "paper"});
+        plan.push_back({spec, f == "paper", false});
+        if (vertical) plan.push_back({spec, f == "paper", true});
       }
     }
-    for (const auto& [spec, paper] : plan) {
+    for (const auto& [spec, paper, with_vertical] : plan) {
       sunvo::experiment::ExperimentOptions run_options = options;
       run_options.fusion.estimate_base_attitude = !paper;
+      if (with_vertical) run_options.vertical = vertical_model;
       auto run = sunvo::experiment::runRoute(*route, spec, run_options);
       if (!run) return sunvo::cli::fail(kProgram, route->name + ": " + run.status().toString());
       std::fprintf(stderr, "  %-28s done (%.2f ms/frame median, %d lost)\n", run->name.c_str(),
@@ -234,15 +266,20 @@ int main(int argc, char** argv) {
     std::printf("\n### %s (%zu frames, %.0f m)\n\n%s", route->name.c_str(), input.num_poses,
                 runs.front().evaluation.table1.gt_path_length_m, table->c_str());
     const auto& base = runs.front().evaluation.table1;
+    const double base_tilt = runs.front().tilt.tilt_rms_rad;
     for (const RunResult& r : runs) {
       const auto& t = r.evaluation.table1;
+      constexpr double kToDeg = 180.0 / 3.141592653589793;
       char line[512];
-      std::snprintf(line, sizeof(line),
-                    "| %s | %s | %.2f | %+.0f %% | %.2f | %+.0f %% | %llu / %llu |\n", id.c_str(),
-                    r.name.c_str(), t.final_drift_m, pctChange(base.final_drift_m, t.final_drift_m),
-                    t.rot_armse_rad * 1e3, pctChange(base.rot_armse_rad, t.rot_armse_rad),
-                    static_cast<unsigned long long>(r.gate.accepted),
-                    static_cast<unsigned long long>(r.gate.total()));
+      std::snprintf(
+          line, sizeof(line),
+          "| %s | %s | %.2f | %+.0f %% | %.2f | %+.0f %% | %llu / %llu | %.3f | %+.0f %% |\n",
+          id.c_str(), r.name.c_str(), t.final_drift_m,
+          pctChange(base.final_drift_m, t.final_drift_m), t.rot_armse_rad * 1e3,
+          pctChange(base.rot_armse_rad, t.rot_armse_rad),
+          static_cast<unsigned long long>(r.gate.accepted),
+          static_cast<unsigned long long>(r.gate.total()), r.tilt.tilt_rms_rad * kToDeg,
+          pctChange(base_tilt, r.tilt.tilt_rms_rad));
       summary += line;
     }
   }

@@ -76,6 +76,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0, 100000));
   bool paper_form = false;
   app.add_flag("--paper-form", paper_form, "hold the base attitude fixed, as the paper did");
+  bool vertical = false;
+  app.add_flag("--vertical", vertical,
+               "also a run with the vertical vanishing-point cue alone (\"VO+vertical\", no sun)");
   bool self_calib = false;
   app.add_flag("--self-calib", self_calib,
                "online stereo self-calibration of the right camera (measures the right rows)");
@@ -131,12 +134,19 @@ int main(int argc, char** argv) {
   std::vector<sunvo::Isometry3> gt;
   auto estimators = sunvo::sunestimators::makeSunEstimators(estimator_names, model);
   if (!estimators) return sunvo::cli::fail(kProgram, estimators.status());
-  const std::size_t num_runs = specs.size() + estimators->size();
+  // Runs: pure VO, [VO+vertical], the error-model sources, the image estimators.
+  const std::size_t extra = vertical ? 1 : 0;
+  const std::size_t num_runs = specs.size() + extra + estimators->size();
+  sunvo::replay::ReplayOptions vertical_options = options;
+  vertical_options.vertical.enabled = true;
+  const Eigen::Vector3d up_w = data->worldUp();
   for (std::size_t i = 0; i < num_runs; ++i) {
-    const bool image = i >= specs.size();
+    const bool image = i >= specs.size() + extra;
     auto run = image ? sunvo::replay::replayDrive(*data, options, std::nullopt,
-                                                  (*estimators)[i - specs.size()].get())
-                     : sunvo::replay::replayDrive(*data, options, specs[i]);
+                                                  (*estimators)[i - specs.size() - extra].get())
+               : (vertical && i == 1)
+                   ? sunvo::replay::replayDrive(*data, vertical_options, std::nullopt)
+                   : sunvo::replay::replayDrive(*data, options, specs[i > 0 ? i - extra : 0]);
     if (!run) return sunvo::cli::fail(kProgram, run.status());
     // The ground truth of the frames processed (dropped frames have no pose).
     gt.clear();
@@ -153,6 +163,22 @@ int main(int argc, char** argv) {
                  static_cast<unsigned long long>(run->gate.accepted),
                  static_cast<unsigned long long>(run->gate.total()),
                  static_cast<unsigned long long>(run->gate.rejected_sun_down));
+    if (auto tilt = sunvo::metrics::computeTilt(gt, run->T_w_c, up_w)) {
+      constexpr double kToDeg = 180.0 / 3.141592653589793;
+      std::fprintf(stderr,
+                   "  %-28s attitude error: tilt (roll/pitch) %.3f deg RMS, %.3f final; heading "
+                   "%.3f deg RMS, %.3f final\n",
+                   "", tilt->tilt_rms_rad * kToDeg, tilt->tilt_final_rad * kToDeg,
+                   tilt->heading_rms_rad * kToDeg, tilt->heading_final_rad * kToDeg);
+    }
+    if (run->vertical_stats.calls > 0) {
+      std::fprintf(stderr,
+                   "  %-28s vertical cue: %llu calls, %llu valid, %llu accepted, %llu errors\n", "",
+                   static_cast<unsigned long long>(run->vertical_stats.calls),
+                   static_cast<unsigned long long>(run->vertical_stats.valid),
+                   static_cast<unsigned long long>(run->vertical_gate.accepted),
+                   static_cast<unsigned long long>(run->vertical_stats.errors));
+    }
     if (self_calib) {
       const auto& sc = run->self_calibration;
       std::fprintf(stderr,

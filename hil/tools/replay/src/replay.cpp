@@ -12,6 +12,7 @@ Status ReplayOptions::validate() const {
   }
   SUNVO_RETURN_IF_ERROR(pipeline.validate());
   SUNVO_RETURN_IF_ERROR(fusion.validate());
+  SUNVO_RETURN_IF_ERROR(vertical.estimator.validate());
   if (max_consecutive_bad_frames < 0 || max_consecutive_bad_frames > 100000) {
     return invalidArgument("replay.max_consecutive_bad_frames out of range [0, 100000]");
   }
@@ -74,6 +75,7 @@ Expected<ReplayRun> replayDrive(const dataset::Dataset& data, const ReplayOption
   sao.pipeline.vo.window.max_solver_time_in_seconds = 60.0;  // replay: bounded by iterations only
   sao.use_sun = sun;
   sao.every_n_frames = options.every_n_frames;
+  sao.vertical = options.vertical;
   sao.fusion = image_sun != nullptr ? options.imageFusion() : options.fusion;
   sao.fusion.world_up = data.worldUp();
   std::optional<sunfusion::SimulatedSunSource> sun_source;
@@ -89,6 +91,8 @@ Expected<ReplayRun> replayDrive(const dataset::Dataset& data, const ReplayOption
   run.name = spec                   ? spec->name
              : image_sun != nullptr ? "VO+Sun (" + std::string(image_sun->name()) + ")"
                                     : "Pure VO";
+  if (options.vertical.enabled)
+    run.name = run.name == "Pure VO" ? "VO+vertical" : run.name + " +vertical";
   StereoFrame frame;
   std::vector<double> ms;
   int bad_in_a_row = 0;
@@ -143,6 +147,8 @@ Expected<ReplayRun> replayDrive(const dataset::Dataset& data, const ReplayOption
     run.self_calibration = r->self_calibration;
   }
   run.gate = vo.sunCounters();
+  run.vertical_gate = vo.verticalCounters();
+  run.vertical_stats = vo.verticalStats();
   run.median_ms = metrics::percentile(ms, 0.5);
   run.p99_ms = metrics::percentile(ms, 0.99);
   return run;

@@ -204,6 +204,19 @@ Expected<Evaluation> evaluate(const std::vector<Isometry3>& T_w_c_gt,
                               const std::vector<Isometry3>& T_w_c_est,
                               const EvaluationOptions& options = {});
 
+// The attitude error split by gravity: e_k = logSO3(C_gt,k C_est,k^T) (world frame,
+// C_gt = Exp(e) C_est), its tilt (roll/pitch) part |e_k - (e_k . up_w) up_w| and its heading part
+// |e_k . up_w|; RMS over all poses and at the last one, rad. up_w: unit, the world's up.
+struct TiltMetrics {
+  double tilt_rms_rad = 0.0;
+  double tilt_final_rad = 0.0;
+  double heading_rms_rad = 0.0;
+  double heading_final_rad = 0.0;
+};
+Expected<TiltMetrics> computeTilt(const std::vector<Isometry3>& T_w_c_gt,
+                                  const std::vector<Isometry3>& T_w_c_est,
+                                  const Eigen::Vector3d& up_w);
+
 // Cumulative ground-truth distance dist[k] (see the KITTI metric) [m].
 std::vector<double> cumulativeDistances(const std::vector<Isometry3>& T_w_c);
 

@@ -79,6 +79,7 @@ struct StageTimes {
   double window_ms = 0.0;        // back end: window update + Ceres solve
   double odometry_ms = 0.0;      // the whole back end call (>= ransac + window)
   double total_ms = 0.0;         // process() from entry to return
+  double vertical_ms = 0.0;      // the vertical cue (SunAidedOdometry, its frames; in total_ms)
   double detect_cpu_ms = 0.0;    // CPU time of detect
   double match_cpu_ms = 0.0;     // CPU time of temporal + stereo matching
   double frontend_cpu_ms = 0.0;  // CPU time of the whole front end call

@@ -15,6 +15,11 @@
 // sun_w, the sun in the VO world, comes from the caller (an ephemeris at the frame's time and
 // place, or a dataset's truth), so this class stays free of clocks and positions.
 //
+// With vertical.enabled and image input, the same every-n frames also measure the camera's "up"
+// from the left image (estimator/vertical: the vertical vanishing point) and give it to the fusion
+// as a second absolute direction (SunWindowTerm::addVertical), with or without the sun; with
+// feature input there are no images and the cue is skipped (verticalActive() is false).
+//
 // No threads, files or devices; deterministic for the same inputs. Not thread-safe except
 // isSunFrame(), which reads the immutable schedule (the rover's capture thread asks it).
 
@@ -27,14 +32,28 @@
 #include "sunvo/core/stereo_frame.hpp"
 #include "sunvo/pipeline/stereo_image_odometry.hpp"
 #include "sunvo/sunfusion/sun_window_term.hpp"
+#include "sunvo/vertical/vertical_estimator.hpp"
 
 namespace sunvo::pipeline {
+
+// The gravity cue. Config keys: vertical.enabled and the estimator's keys (vertical.max_tilt_deg,
+// ...; vertical_estimator.hpp).
+struct VerticalCueOptions {
+  bool enabled = false;  // measure "up" from the left image on the every-n frames (images only)
+  vertical::VerticalOptions estimator;
+  template <class Self, class V>
+  static void fields(Self& s, V& v) {
+    v("enabled", s.enabled);
+    vertical::VerticalOptions::fields(s.estimator, v);
+  }
+};
 
 struct SunAidedOptions {
   PipelineOptions pipeline;            // front end (image input) and back end
   bool use_sun = true;                 // false: pure VO (the schedule never asks for the sun)
   int every_n_frames = 5;              // a sun measurement every n-th frame, [1, 1000]
   sunfusion::SunFusionOptions fusion;  // gate, world "up", attitude model (sun_window_term.hpp)
+  VerticalCueOptions vertical;         // the camera's "up" from the images (off by default)
 
   // The error names the bad key relative to these options ("every_n_frames", "fusion.x",
   // "window.x").
@@ -46,6 +65,7 @@ struct SunAidedOptions {
     PipelineOptions::fields(s.pipeline, v);
     v("every_n_frames", s.every_n_frames);
     v("fusion", s.fusion);
+    v("vertical", s.vertical);
   }
 };
 
@@ -65,9 +85,17 @@ class SunAidedOdometry {
     return options_.use_sun && sequence > 0 &&
            sequence % static_cast<std::uint64_t>(options_.every_n_frames) == 0;
   }
+  // The frames of the every-n schedule, sun or not (the vertical cue's frames).
+  bool isCueFrame(std::uint64_t sequence) const {
+    return sequence > 0 && sequence % static_cast<std::uint64_t>(options_.every_n_frames) == 0;
+  }
   // A measurement in camera k (observation.measurement.sequence = k) with the sun in the world.
   // Ignored (counted in sunOffered() only) when the sun is off.
   void addSun(const sunfusion::SunObservation& observation);
+  // An "up" measured by another source (an error model, an accelerometer at rest) for camera k:
+  // measurement.sun_c = up in camera k, sun_w = fusion.world_up. Used when vertical.enabled (with
+  // any input); ignored otherwise.
+  void addVertical(const sunfusion::SunObservation& observation);
 
   Expected<FrameResult> process(const StereoFrame& frame);     // kImages
   Expected<vo::VoResult> process(const FrameFeatures& frame);  // kFeatures
@@ -79,6 +107,16 @@ class SunAidedOdometry {
   const Eigen::Matrix3d& attitudeCovariance() const { return sun_term_.attitudeCovariance(); }
   const sunfusion::SunWindowTerm& sunTerm() const { return sun_term_; }
   std::uint64_t sunOffered() const { return sun_offered_; }
+  // The vertical cue: active (enabled, image input), its gate counters, and the estimator's
+  // calls, valid answers and input errors (a frame whose image it refused; the run goes on).
+  bool verticalActive() const { return vertical_active_; }
+  const sunfusion::GateCounters& verticalCounters() const { return sun_term_.verticalCounters(); }
+  struct VerticalStats {
+    std::uint64_t calls = 0;
+    std::uint64_t valid = 0;
+    std::uint64_t errors = 0;
+  };
+  const VerticalStats& verticalStats() const { return vertical_stats_; }
 
   // The rover shrinks the solver's time budget when a frame is late (seconds, > 0).
   void setSolverTimeBudget(double seconds);
@@ -100,6 +138,9 @@ class SunAidedOdometry {
   StereoImageOdometry vo_;          // image input: front end + its own back end
   vo::StereoTrackOdometry tracks_;  // feature input: the back end alone
   sunfusion::SunWindowTerm sun_term_;
+  vertical::VerticalEstimator vertical_;
+  bool vertical_active_ = false;
+  VerticalStats vertical_stats_;
   Isometry3 T_w_c_ = Isometry3::Identity();
   std::uint64_t sun_offered_ = 0;
   bool initialized_ = false;

@@ -47,6 +47,36 @@ class SimulatedSunSource {
   std::mt19937_64 rng_;
 };
 
+// An "up" source for ablations: the true up in the camera (C_c_w up_w) turned by a small random
+// rotation, each camera axis N(bias, sigma) (x: pitch, z: roll, y: about up itself, no effect), or
+// for an outlier by outlier_deg about a random axis across it, or nothing (dropout). It emulates the vertical
+// vanishing point (estimator/vertical), whose measured statistics are in docs/vertical.md.
+struct VerticalErrorModel {
+  double sigma_deg = 1.0;           // per-axis Gaussian error, [0, 30] deg
+  double pitch_bias_deg = 0.0;      // mean error about camera x, [-10, 10] deg
+  double roll_bias_deg = 0.0;       // mean error about camera z, [-10, 10] deg
+  double outlier_share = 0.0;       // share turned by outlier_deg instead, [0, 1]
+  double outlier_deg = 8.0;         // [0, 90] deg
+  double dropout_share = 0.0;       // share of frames without a measurement, [0, 1]
+  double reported_sigma_deg = 1.0;  // sigma written into each measurement, (0, 30] deg
+  std::uint32_t seed = 1;           // RNG seed
+
+  Status validate() const;
+};
+
+class SimulatedVerticalSource {
+ public:
+  explicit SimulatedVerticalSource(const VerticalErrorModel& model)
+      : model_(model), rng_(model.seed) {}
+  // A measurement (kFull3d, sun_c = the measured up) or nothing; fixed draws per call.
+  std::optional<SunMeasurement> measure(std::uint64_t sequence, TimeNs time_ns,
+                                        const Eigen::Vector3d& true_up_c);
+
+ private:
+  VerticalErrorModel model_;
+  std::mt19937_64 rng_;
+};
+
 // Camera-frame azimuth/zenith (radians) <-> unit vector, as defined above.
 Eigen::Vector3d sunFromAzimuthZenith(double azimuth_rad, double zenith_rad);
 void azimuthZenithFromSun(const Eigen::Vector3d& sun_c, double& azimuth_rad, double& zenith_rad);

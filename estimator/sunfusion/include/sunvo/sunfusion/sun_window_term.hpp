@@ -37,6 +37,12 @@
 //      the step down, so that q_theta sinks to its minimum (the sun barely moves VO) under noise
 //      alone and rises only when the evidence of a drift accumulates, up to
 //      max_drift_deg_per_frame.
+//      With split_drift_by_gravity (default) the walk has two sizes: q_tilt on the plane normal to
+//      world_up, q_heading along it (P += N (q_tilt^2 (I - u u^T) + q_heading^2 u u^T)). q_tilt
+//      steps on the test of all channels' sums; q_heading only on sun measurements, on the test of
+//      sums of the sun's measurements alone. A precise "up" (vertical channel) that evidences a
+//      tilt drift thus no longer widens the heading, which a 12-20 deg sun would then pull around
+//      (measured: docs/vertical.md). Without vertical measurements both are the same q_theta.
 //    * kInnovationMedian: one log-step up when a measurement's r^T S^-1 r exceeds the chi-square
 //      median of its rows, one down otherwise. With a correct R_s and P << R_s this rule walks
 //      at random, and outliers push it up: kept for comparison (docs/experiment.md).
@@ -56,11 +62,20 @@
 //    r^T (J P_b J^T + I)^-1 r above that bound: once the filter is confident, shadow flips and
 //    outliers that the wide cosine gate lets in are refused.
 //
+// A second channel of the same form: the camera's "up" measured from the images (the vertical
+// vanishing point, estimator/vertical) is a known world direction (world_up) seen in camera k,
+// exactly like the sun; addVertical() puts it through its own gate (vertical_gate) and the same
+// innovation and correction gates, residual, P and drift adaptation, counted apart
+// (verticalCounters()). One sun direction leaves the rotation about the sun axis free; "up"
+// fixes roll and pitch, so the two together observe the whole attitude.
+//
 // Nothing here allocates per frame except the cost functions of an accepted measurement (every
 // fifth frame by default), which live until the next solve.
 
 #include <ceres/loss_function.h>
 
+#include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <array>
 #include <memory>
 #include <optional>
@@ -87,6 +102,14 @@ inline std::span<const std::string_view> enumNames(DriftAdaptation) {
 
 struct SunFusionOptions {
   SunGateOptions gate;
+  // Gate of the vertical channel (addVertical): the default refuses an "up" more than 10 deg from
+  // the predicted one (1 - cos 10 deg); the vertical-error gate is off (it is a sun cue).
+  SunGateOptions vertical_gate = [] {
+    SunGateOptions g;
+    g.max_cosine_distance = 0.0152;
+    g.max_vertical_error = 2.0;
+    return g;
+  }();
   // Unit vector "up" in the VO world frame, for the sun-elevation gate: ENU (0, 0, 1); a KITTI
   // camera-0 world has up = (0, -1, 0).
   Eigen::Vector3d world_up = Eigen::Vector3d::UnitZ();
@@ -117,6 +140,11 @@ struct SunFusionOptions {
   double persistence_step_up = 0.5;
   double persistence_step_down = 0.1;
   double persistence_huber = 2.0;
+  // Persistence rule: one q_theta for the tilt (roll/pitch: the plane normal to world_up), tested
+  // on every channel, and one for the heading (about world_up), tested on the sun's measurements
+  // only (header comment); false = one q_theta for all three axes, as before 2026-11-26. The
+  // same without vertical measurements.
+  bool split_drift_by_gravity = true;
   // Innovation gate bound on r^T S^-1 r, [0, 1e6]; 0 = off. 16.3 = chi-square 3 dof, 99.9 %.
   double innovation_gate_chi2 = 16.3;
   // Evidence rule: how many standard deviations of its estimate an error must reach along a
@@ -137,6 +165,7 @@ struct SunFusionOptions {
   template <class Self, class V>
   static void fields(Self& s, V& v) {
     v("gate", s.gate);
+    v("vertical_gate", s.vertical_gate);
     v("loss_scale", s.loss_scale);
     v("estimate_base_attitude", s.estimate_base_attitude);
     v("initial_attitude_sigma_deg", s.initial_attitude_sigma_deg);
@@ -150,6 +179,7 @@ struct SunFusionOptions {
     v("persistence_step_up", s.persistence_step_up);
     v("persistence_step_down", s.persistence_step_down);
     v("persistence_huber", s.persistence_huber);
+    v("split_drift_by_gravity", s.split_drift_by_gravity);
     v("innovation_gate_chi2", s.innovation_gate_chi2);
     v("evidence_sigmas", s.evidence_sigmas);
     v("evidence_forgetting", s.evidence_forgetting);
@@ -165,14 +195,26 @@ class SunWindowTerm {
   void attach(backend::BundleWindow& window);
   // Measurement for a frame that is about to be added to the window (or already is).
   void addObservation(const SunObservation& observation);
+  // The camera's "up" for a frame, as a direction observation: measurement.sun_c = up in camera
+  // k, sun_w = the world's up (options.world_up), sigma its 1-sigma angle (rad).
+  void addVertical(const SunObservation& observation);
 
   const GateCounters& counters() const { return counters_; }
+  const GateCounters& verticalCounters() const { return vertical_counters_; }
   // Result of the gate for the last measurement decided (for logs and the sun thread).
   std::optional<GateResult> lastDecision() const { return last_decision_; }
   // Current uncertainty (rad^2) of the VO world attitude, world frame (base-attitude mode).
   const Eigen::Matrix3d& attitudeCovariance() const { return P_; }
-  // The attitude random walk q_theta in use, deg/frame (adapted unless kFixed).
-  double driftDegPerFrame() const { return drift_deg_per_frame_; }
+  // The attitude random walk q_theta in use, deg/frame (adapted unless kFixed); with
+  // split_drift_by_gravity the larger of the tilt's and the heading's, given apart below.
+  double driftDegPerFrame() const {
+    return splitByGravity() ? std::max(drift_deg_per_frame_, heading_drift_deg_per_frame_)
+                            : drift_deg_per_frame_;
+  }
+  double tiltDriftDegPerFrame() const { return drift_deg_per_frame_; }
+  double headingDriftDegPerFrame() const {
+    return splitByGravity() ? heading_drift_deg_per_frame_ : drift_deg_per_frame_;
+  }
   // Last value of the persistence statistic T (0 before the first accepted measurement).
   double persistenceStatistic() const { return persistence_T_; }
   // The last correction of the base's world attitude (base-attitude mode), for diagnostics:
@@ -219,30 +261,45 @@ class SunWindowTerm {
   };
   static bool innovation(const ceres::CostFunction& cost, const Isometry3& T_k_b,
                          const Eigen::Matrix3d& P_b, Innovation* out);
-  // One adaptation step of q_theta from an accepted measurement's innovation (C_w_b: base).
-  void adaptDrift(const Innovation& inn, const Eigen::Matrix3d& C_w_b);
-  // Adds an accepted measurement to the forgotten sums I and g (world frame).
-  void accumulate(const Innovation& inn, const Eigen::Matrix3d& C_w_b);
+  // One adaptation step of q_theta from an accepted measurement's innovation (C_w_b: base;
+  // channel 0 sun, 1 vertical).
+  void adaptDrift(const Innovation& inn, const Eigen::Matrix3d& C_w_b, int channel);
+  bool splitByGravity() const;
+  double clampDrift(double q) const;
+  // T = g^T I^+ g and the rank of I (the persistence test).
+  static double persistenceStatistic(const Eigen::Matrix3d& I, const Eigen::Vector3d& g,
+                                     std::size_t* rank);
+  // Adds an accepted measurement to forgotten sums I and g (world frame).
+  void accumulate(const Innovation& inn, const Eigen::Matrix3d& C_w_b, Eigen::Matrix3d* I,
+                  Eigen::Vector3d* g) const;
   // Evidence rule: widens P along directions where I^+ g stands out of its noise.
   void inflateToEvidence();
 
   SunFusionOptions options_;
   std::unique_ptr<ceres::LossFunction> loss_;
-  std::array<Pending, backend::BundleWindow::kMaxWindowSize> pending_;  // ring by sequence
-  std::array<bool, backend::BundleWindow::kMaxWindowSize> used_{};
+  // Ring by sequence, two channels per frame: index (sequence % kMaxWindowSize) * 2 + channel.
+  static constexpr int kChannels = 2;  // 0: sun, 1: vertical
+  static constexpr std::size_t kSlots = backend::BundleWindow::kMaxWindowSize * kChannels;
+  void add(const SunObservation& observation, int channel);
+  std::array<Pending, kSlots> pending_;
+  std::array<bool, kSlots> used_{};
   GateCounters counters_;
+  GateCounters vertical_counters_;
   std::optional<GateResult> last_decision_;
   // Base-attitude mode state.
-  std::array<double, 3> delta_{0.0, 0.0, 0.0};               // delta_b of the current solve
-  Eigen::Matrix3d P_ = Eigen::Matrix3d::Zero();              // of dtheta_w, world frame, rad^2
-  double drift_deg_per_frame_ = 0.0;                         // q_theta in use, deg/frame (adapted)
+  std::array<double, 3> delta_{0.0, 0.0, 0.0};   // delta_b of the current solve
+  Eigen::Matrix3d P_ = Eigen::Matrix3d::Zero();  // of dtheta_w, world frame, rad^2
+  double drift_deg_per_frame_ = 0.0;          // q_theta in use (the tilt's when split), deg/frame
+  double heading_drift_deg_per_frame_ = 0.0;  // the heading's q_theta when split, deg/frame
   Eigen::Vector3d persistence_g_ = Eigen::Vector3d::Zero();  // forgotten sum of H^T w r
   Eigen::Matrix3d persistence_I_ = Eigen::Matrix3d::Zero();  // forgotten sum of H^T H
+  Eigen::Vector3d sun_g_ = Eigen::Vector3d::Zero();  // the same sums, sun channel only (split)
+  Eigen::Matrix3d sun_I_ = Eigen::Matrix3d::Zero();
   double persistence_T_ = 0.0;
   std::array<double, 4> persistence_bound_{};  // chi-square quantile by rank 1..3
   std::optional<std::uint64_t> last_sequence_;
   std::unique_ptr<ceres::CostFunction> prior_cost_;
-  std::array<int, backend::BundleWindow::kMaxWindowSize> used_in_solve_{};  // ring indices
+  std::array<int, kSlots> used_in_solve_{};  // ring indices
   int num_used_ = 0;
   Correction last_correction_;
   std::uint64_t num_corrections_ = 0;

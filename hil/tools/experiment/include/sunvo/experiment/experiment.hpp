@@ -52,6 +52,9 @@ struct ExperimentOptions {
   vo::VoOptions vo;
   int every_n_frames = 5;  // a sun measurement every n-th frame, [1, 1000]
   int max_frames = 0;      // 0 = the whole route; else the first max_frames frames, >= 0
+  // A simulated "up" measurement on the every-n frames of every run (the vertical cue's error
+  // model; none by default). A pure-VO run with it is "VO+vertical-like".
+  std::optional<sunfusion::VerticalErrorModel> vertical;
   // Online stereo self-calibration of the tracks before the odometry (off by default).
   selfcal::StereoSelfCalibrationOptions self_calibration;
   // Gate and world_up are set per source / route. VO starts at the ground-truth first pose, so the
@@ -67,7 +70,9 @@ struct ExperimentOptions {
 struct RunResult {
   std::string name;
   std::vector<Isometry3> T_w_c;
-  sunfusion::GateCounters gate;  // all zero for pure VO
+  sunfusion::GateCounters gate;           // all zero for pure VO
+  sunfusion::GateCounters vertical_gate;  // the vertical source's (when options.vertical)
+  metrics::TiltMetrics tilt;              // attitude error split into tilt and heading
   int lost_frames = 0;
   double median_ms = 0.0;  // VO time per frame (association, RANSAC, window), median
   double p99_ms = 0.0;

@@ -31,6 +31,9 @@ struct ReplayOptions {
   dataset::DatasetOptions dataset;
   int every_n_frames = 5;  // a sun measurement every n-th frame, [1, 1000]
   pipeline::PipelineOptions pipeline;
+  // The camera's "up" from the images on the every-n frames (off by default): with the sun or
+  // alone (a pure-VO run then becomes "VO+vertical").
+  pipeline::VerticalCueOptions vertical;
   // The first camera pose comes from the first OXTS record (an RT3000-class INS: about 0.03 deg
   // roll/pitch and 0.1 deg heading), so the attitude prior sigma is 0.1 deg, not the generic 1.
   sunfusion::SunFusionOptions fusion = [] {
@@ -60,11 +63,13 @@ struct ReplayRun {
   std::vector<std::size_t> frame_index;  // each pose's frame: index in the dataset's range
   int dropped_frames = 0;                // bad frames dropped (see ReplayOptions)
   sunfusion::GateCounters gate;
+  sunfusion::GateCounters vertical_gate;                     // the vertical cue's (if enabled)
+  pipeline::SunAidedOdometry::VerticalStats vertical_stats;  // its calls, valid, errors
   int lost_frames = 0;
   double median_ms = 0.0;  // pipeline time per frame
   double p99_ms = 0.0;
-  int sun_calls = 0;           // image estimator calls (every n-th frame)
-  std::vector<double> sun_ms;  // their wall times, ms
+  int sun_calls = 0;                                // image estimator calls (every n-th frame)
+  std::vector<double> sun_ms;                       // their wall times, ms
   selfcal::SelfCalibrationReport self_calibration;  // after the last frame (if enabled)
 };
 
