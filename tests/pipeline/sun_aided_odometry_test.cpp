@@ -174,6 +174,34 @@ TEST(SunAidedOdometryImages, TheImageCueMeasuresUpOnRealFrames) {
   EXPECT_TRUE(odo.attitudeCovariance().allFinite());
 }
 
+TEST_F(SunAidedOdometryTest, FeatureInputSelfCalibratesTheTracksRightRows) {
+  // Right rows 0.3 px below the left ones (a right camera pitched by 0.3 px / fv): with feature
+  // input the self-calibration runs on the tracks before the back end, with no front end and so
+  // no frontend.measure_v_right, and reports what the stand-alone filter reports.
+  for (FrameFeatures& f : frames_) {
+    for (StereoObservation& o : f.observations) o.v_right += 0.3;
+  }
+  options_.use_sun = false;
+  options_.pipeline.self_calibration.enabled = true;
+  ASSERT_FALSE(options_.pipeline.frontend.measure_v_right);
+  SunAidedOdometry odo;
+  ASSERT_TRUE(odo.init(options_, camera_, T_w_c0_, OdometryInput::kFeatures).isOk());
+  selfcal::StereoSelfCalibration alone;
+  ASSERT_TRUE(alone.init(options_.pipeline.self_calibration, camera_).isOk());
+  FrameFeatures corrected;
+  for (const FrameFeatures& f : frames_) {
+    ASSERT_TRUE(odo.process(f));
+    const selfcal::SelfCalibrationReport expected = alone.process(f, &corrected);
+    EXPECT_EQ(odo.lastSelfCalibration().pitch_mrad, expected.pitch_mrad);
+    EXPECT_EQ(odo.lastSelfCalibration().roll_mrad, expected.roll_mrad);
+  }
+  EXPECT_NEAR(odo.lastSelfCalibration().pitch_mrad, 0.3 / camera_.fv * 1e3, 0.05);
+  EXPECT_EQ(odo.lastSelfCalibration().resets, 0u);
+  // The image pipeline still needs the right rows measured.
+  const Status images = odo.init(options_, camera_, T_w_c0_, OdometryInput::kImages);
+  EXPECT_NE(images.message().find("self_calibration.enabled"), std::string::npos);
+}
+
 TEST_F(SunAidedOdometryTest, ScheduleInputsAndOptionsAreChecked) {
   SunAidedOdometry odo;
   options_.every_n_frames = 3;

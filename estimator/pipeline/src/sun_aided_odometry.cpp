@@ -18,14 +18,26 @@ Status SunAidedOptions::validate() const {
 Status SunAidedOdometry::init(const SunAidedOptions& options, const StereoCamera& camera,
                               const Isometry3& T_w_c0, OdometryInput input) {
   initialized_ = false;
-  SUNVO_RETURN_IF_ERROR(options.validate());
+  if (input == OdometryInput::kFeatures) {
+    // No front end: the tracks carry their own right rows, so the self-calibration does not need
+    // frontend.measure_v_right.
+    SunAidedOptions checked = options;
+    checked.pipeline.frontend.measure_v_right = true;
+    SUNVO_RETURN_IF_ERROR(checked.validate());
+  } else {
+    SUNVO_RETURN_IF_ERROR(options.validate());
+  }
   options_ = options;
   input_ = input;
   if (input == OdometryInput::kImages) {
     SUNVO_RETURN_IF_ERROR(vo_.init(options.pipeline, camera, T_w_c0));
   } else {
     SUNVO_RETURN_IF_ERROR(tracks_.init(options.pipeline.vo, camera, T_w_c0));
+    SUNVO_RETURN_IF_ERROR(selfcal_.init(options.pipeline.self_calibration, camera));
+    corrected_.observations.reserve(static_cast<std::size_t>(options.pipeline.vo.max_observations));
   }
+  selfcal_report_ = selfcal::SelfCalibrationReport{};
+  selfcal_ms_ = 0.0;
   backend::BundleWindow& window = backEnd().window();
   vertical_active_ = options.vertical.enabled && input == OdometryInput::kImages;
   vertical_stats_ = VerticalStats{};
@@ -85,6 +97,7 @@ Expected<FrameResult> SunAidedOdometry::process(const StereoFrame& frame) {
   Expected<FrameResult> r = vo_.process(frame);
   if (r) {
     T_w_c_ = r->vo.T_w_c;
+    selfcal_report_ = r->self_calibration;
     r->times.vertical_ms = vertical_ms;
     r->times.total_ms += vertical_ms;
   }
@@ -96,7 +109,15 @@ Expected<vo::VoResult> SunAidedOdometry::process(const FrameFeatures& frame) {
     return failedPrecondition(
         "SunAidedOdometry::process(FrameFeatures): not initialised for features");
   }
-  Expected<vo::VoResult> r = tracks_.process(frame);
+  const FrameFeatures* in = &frame;
+  if (selfcal_.enabled()) {
+    const auto t0 = std::chrono::steady_clock::now();
+    selfcal_report_ = selfcal_.process(frame, &corrected_);
+    in = &corrected_;
+    selfcal_ms_ =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  }
+  Expected<vo::VoResult> r = tracks_.process(*in);
   if (r) T_w_c_ = r->T_w_c;
   return r;
 }

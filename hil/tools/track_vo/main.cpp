@@ -117,17 +117,13 @@ int main(int argc, char** argv) {
   std::size_t n = seq->frames.size();
   if (args.max_frames > 0) n = std::min(n, static_cast<std::size_t>(args.max_frames));
 
+  options.pipeline.self_calibration = selfcal_opt;
   sunvo::pipeline::SunAidedOdometry vo;
   if (auto s = vo.init(options, seq->camera, Isometry3::Identity(),
                        sunvo::pipeline::OdometryInput::kFeatures);
       !s.isOk()) {
     return sunvo::cli::fail(kProgram, s);
   }
-  sunvo::selfcal::StereoSelfCalibration selfcal;
-  if (auto s = selfcal.init(selfcal_opt, seq->camera); !s.isOk()) {
-    return sunvo::cli::fail(kProgram, s);
-  }
-  sunvo::FrameFeatures corrected;
   std::FILE* selfcal_log =
       args.selfcal_log_path.empty() ? nullptr : std::fopen(args.selfcal_log_path.c_str(), "w");
   if (!args.selfcal_log_path.empty() && selfcal_log == nullptr) {
@@ -153,23 +149,20 @@ int main(int argc, char** argv) {
   long iterations = 0;
   for (std::size_t k = 0; k < n; ++k) {
     const auto t0 = std::chrono::steady_clock::now();
-    const sunvo::FrameFeatures* frame = &seq->frames[k];
-    if (selfcal.enabled()) {
-      const auto rep = selfcal.process(*frame, &corrected);
-      frame = &corrected;
-      selfcal_ms.push_back(
-          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-      if (selfcal_log != nullptr) {
-        std::fprintf(selfcal_log, "%zu,%.5f,%.5f,%.7f,%.5f,%d,%d\n", k, rep.pitch_mrad,
-                     rep.roll_mrad, rep.scale, rep.roll_sigma_mrad, rep.used, rep.reset ? 1 : 0);
-      }
-    }
-    auto r = vo.process(*frame);
+    auto r = vo.process(seq->frames[k]);
     const double ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     if (!r) {
       return sunvo::cli::fail(kProgram,
                               "frame " + std::to_string(k) + ": " + r.status().toString());
+    }
+    if (selfcal_opt.enabled) {
+      const sunvo::selfcal::SelfCalibrationReport& rep = vo.lastSelfCalibration();
+      selfcal_ms.push_back(vo.lastSelfCalibrationMs());
+      if (selfcal_log != nullptr) {
+        std::fprintf(selfcal_log, "%zu,%.5f,%.5f,%.7f,%.5f,%d,%d\n", k, rep.pitch_mrad,
+                     rep.roll_mrad, rep.scale, rep.roll_sigma_mrad, rep.used, rep.reset ? 1 : 0);
+      }
     }
     poses.push_back(r->T_w_c);
     if (log != nullptr) {
@@ -191,12 +184,13 @@ int main(int argc, char** argv) {
   }
   if (log != nullptr) std::fclose(log);
   if (selfcal_log != nullptr) std::fclose(selfcal_log);
-  if (selfcal.enabled()) {
+  if (selfcal_opt.enabled) {
+    const sunvo::selfcal::SelfCalibrationReport& rep = vo.lastSelfCalibration();
     std::printf(
         "self-calibration: right camera pitch %.4f mrad, roll %.4f mrad, vertical scale "
         "%.6f at the end; %llu resets; %.4f ms/frame median\n",
-        selfcal.state()[0] * 1e3, selfcal.state()[1] * 1e3, selfcal.state()[2],
-        static_cast<unsigned long long>(selfcal.resets()), percentile(selfcal_ms, 50));
+        rep.pitch_mrad, rep.roll_mrad, rep.scale, static_cast<unsigned long long>(rep.resets),
+        percentile(selfcal_ms, 50));
   }
   sunvo::files::Trajectory out_traj;
   out_traj.T_w_c = poses;

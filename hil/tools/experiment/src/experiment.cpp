@@ -36,6 +36,7 @@ Expected<RunResult> runRoute(const Route& route, const std::optional<SunSourceSp
   sao.pipeline.vo = options.vo;
   sao.use_sun = spec.has_value();
   sao.every_n_frames = options.every_n_frames;
+  sao.pipeline.self_calibration = options.self_calibration;
   sao.fusion = options.fusion;
   sao.fusion.world_up = route.world_up;
   std::optional<sunfusion::SimulatedSunSource> source;
@@ -53,9 +54,6 @@ Expected<RunResult> runRoute(const Route& route, const std::optional<SunSourceSp
   SUNVO_RETURN_IF_ERROR(
       odometry.init(sao, route.camera, route.T_w_c_gt[0], pipeline::OdometryInput::kFeatures));
 
-  selfcal::StereoSelfCalibration selfcal;
-  SUNVO_RETURN_IF_ERROR(selfcal.init(options.self_calibration, route.camera));
-  FrameFeatures corrected;
   RunResult result;
   result.name = spec ? spec->name : "Pure VO";
   if (vertical) result.name = spec ? result.name + " +vertical-like" : "VO+vertical-like";
@@ -74,12 +72,7 @@ Expected<RunResult> runRoute(const Route& route, const std::optional<SunSourceSp
       if (m) odometry.addVertical({*m, route.world_up});
     }
     const auto t0 = std::chrono::steady_clock::now();
-    const FrameFeatures* in = &frame;
-    if (selfcal.enabled()) {
-      selfcal.process(frame, &corrected);
-      in = &corrected;
-    }
-    auto r = odometry.process(*in);
+    auto r = odometry.process(frame);
     const auto t1 = std::chrono::steady_clock::now();
     if (!r) return r.status();
     if (r->status == vo::TrackingStatus::kLost) ++result.lost_frames;
@@ -89,9 +82,9 @@ Expected<RunResult> runRoute(const Route& route, const std::optional<SunSourceSp
   }
   result.gate = odometry.sunCounters();
   result.vertical_gate = odometry.verticalCounters();
-  result.selfcal_pitch_mrad = selfcal.state()[0] * 1e3;
-  result.selfcal_roll_mrad = selfcal.state()[1] * 1e3;
-  result.selfcal_resets = selfcal.resets();
+  result.selfcal_pitch_mrad = odometry.lastSelfCalibration().pitch_mrad;
+  result.selfcal_roll_mrad = odometry.lastSelfCalibration().roll_mrad;
+  result.selfcal_resets = odometry.lastSelfCalibration().resets;
   result.median_ms = metrics::percentile(ms, 0.5);
   result.p99_ms = metrics::percentile(ms, 0.99);
   const std::vector<Isometry3> gt(route.T_w_c_gt.begin(),

@@ -15,6 +15,11 @@
 // sun_w, the sun in the VO world, comes from the caller (an ephemeris at the frame's time and
 // place, or a dataset's truth), so this class stays free of clocks and positions.
 //
+// Online stereo self-calibration (pipeline.self_calibration.enabled) runs for both inputs: inside
+// the image pipeline on the front end's right rows, or here on the tracks' right rows before the
+// back end (feature input; frontend.measure_v_right is then not needed). Either way its report is
+// lastSelfCalibration().
+//
 // With vertical.enabled and image input, the same every-n frames also measure the camera's "up"
 // from the left image (estimator/vertical: the vertical vanishing point) and give it to the fusion
 // as a second absolute direction (SunWindowTerm::addVertical), with or without the sun; with
@@ -118,6 +123,11 @@ class SunAidedOdometry {
   };
   const VerticalStats& verticalStats() const { return vertical_stats_; }
 
+  // The self-calibration's report of the last frame (all zero when it is off), and for feature
+  // input the wall time it took, ms.
+  const selfcal::SelfCalibrationReport& lastSelfCalibration() const { return selfcal_report_; }
+  double lastSelfCalibrationMs() const { return selfcal_ms_; }
+
   // The rover shrinks the solver's time budget when a frame is late (seconds, > 0).
   void setSolverTimeBudget(double seconds);
   // A monotonically increasing event count sampled around the front end and the back end.
@@ -138,6 +148,10 @@ class SunAidedOdometry {
   StereoImageOdometry vo_;          // image input: front end + its own back end
   vo::StereoTrackOdometry tracks_;  // feature input: the back end alone
   sunfusion::SunWindowTerm sun_term_;
+  selfcal::StereoSelfCalibration selfcal_;  // feature input (images: inside vo_)
+  FrameFeatures corrected_;                 // the tracks with corrected right rows
+  selfcal::SelfCalibrationReport selfcal_report_;
+  double selfcal_ms_ = 0.0;
   vertical::VerticalEstimator vertical_;
   bool vertical_active_ = false;
   VerticalStats vertical_stats_;
