@@ -4,7 +4,6 @@
 #include <bit>
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
 #include <cstring>
 #include <ctime>
 #include <string>
@@ -292,10 +291,10 @@ bool StereoFrontend::refineStereo(int li, int ri, StereoObservation& obs) const 
 //   R(x + du, y + dv) ~ R + du R_x + dv R_y = L   over the (2 kRefineRadius + 1)^2 window,
 // least squares: [S R_x^2, S R_x R_y; S R_x R_y, S R_y^2] (du, dv) = S (L - R) (R_x, R_y), with
 // central differences averaged over both images for R_x, R_y (a symmetric step). Both offsets
-// are solved (the column's is not whole either) and only dv is used: v_right = v + sv + dv +
-// dv_left (the keypoint's own subpixel row). The row is kept when the window determines it: the
-// smaller eigenvalue of the 2x2 matrix at least kMinEigenvalueRatio of the larger (not along
-// an edge) and |dv| <= 1 px.
+// are solved: v_right = v + sv + dv + dv_left (the keypoint's own subpixel row) and, when
+// |du| <= 1 px, u_right = ur + du + du_left in place of the parabola's. Both are kept only when
+// the window determines them: the smaller eigenvalue of the 2x2 matrix at least
+// kMinEigenvalueRatio of the larger (not along an edge) and |dv| <= 1 px.
 void StereoFrontend::measureRightRow(const Keypoint& lk, int ur, int sv,
                                      StereoObservation& obs) const {
   const std::ptrdiff_t right_shift = static_cast<std::ptrdiff_t>(sv) * stride_;
@@ -334,9 +333,19 @@ void StereoFrontend::measureRightRow(const Keypoint& lk, int ur, int sv,
   const double lmax = 0.5 * tr + disc;
   if (!(det > 0.0) || !(lmin >= kMinEigenvalueRatio * lmax)) return;
   const double dv = (a11 * b2 - a12 * b1) / det;
+  const double du = (a22 * b1 - a12 * b2) / det;
   if (!std::isfinite(dv) || std::abs(dv) > 1.0) return;
   obs.v_right = lk.v + sv + dv + static_cast<double>(lk.dv);
   obs.v_right_measured = true;
+  // The column from the same step: the parabola above is taken along row v, and where the right
+  // row is off (a rig error; under 0.1 deg of roll up to 1 px at the image's corners) a slanted
+  // edge moves sideways with the row, which biases the disparity (docs/backend.md, measured).
+  const double u_right = ur + du + static_cast<double>(lk.du);
+  const double disparity = obs.u_left - u_right;
+  if (std::isfinite(du) && std::abs(du) <= 1.0 && disparity >= options_.min_disparity &&
+      disparity <= options_.max_disparity) {
+    obs.u_right = u_right;
+  }
 }
 
 Status StereoFrontend::process(const cv::Mat& left, const cv::Mat& right, TimeNs t,

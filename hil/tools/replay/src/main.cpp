@@ -81,7 +81,8 @@ int main(int argc, char** argv) {
                "also a run with the vertical vanishing-point cue alone (\"VO+vertical\", no sun)");
   bool self_calib = false;
   app.add_flag("--self-calib", self_calib,
-               "online stereo self-calibration of the right camera (measures the right rows)");
+               "online stereo self-calibration of the right camera (measures the right rows); its "
+               "estimate per frame in OUT/self_calibration_<run>.csv");
   app.add_option("--estimators", estimator_names,
                  "also VO + sun from these image estimators: lalonde, lalonde_vo, sun_cnn")
       ->delimiter(',')
@@ -180,6 +181,20 @@ int main(int argc, char** argv) {
                    static_cast<unsigned long long>(run->vertical_stats.errors));
     }
     if (self_calib) {
+      // Per frame: OUT/self_calibration_<run>.csv (the right camera's estimate after each frame).
+      std::string csv = "frame,pitch_mrad,roll_mrad,scale,roll_sigma_mrad,used,reset\n";
+      char row[160];
+      for (std::size_t f = 0; f < run->self_calibration_log.size(); ++f) {
+        const auto& r = run->self_calibration_log[f];
+        std::snprintf(row, sizeof(row), "%zu,%.5f,%.5f,%.7f,%.5f,%d,%d\n", run->frame_index[f],
+                      r.pitch_mrad, r.roll_mrad, r.scale, r.roll_sigma_mrad, r.used,
+                      r.reset ? 1 : 0);
+        csv += row;
+      }
+      const std::string path = out_dir + "/self_calibration_" + fileSlug(run->name) + ".csv";
+      if (auto s = sunvo::files::writeWholeFile(path, csv); !s.isOk()) {
+        return sunvo::cli::fail(kProgram, s);
+      }
       const auto& sc = run->self_calibration;
       std::fprintf(stderr,
                    "  %-28s self-calibration: right pitch %+.4f deg, roll %+.4f deg (sigma "

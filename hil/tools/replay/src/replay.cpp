@@ -145,6 +145,9 @@ Expected<ReplayRun> replayDrive(const dataset::Dataset& data, const ReplayOption
     run.times_ns.push_back(frame.trigger_time_ns);
     run.frame_index.push_back(k);
     run.self_calibration = r->self_calibration;
+    if (options.pipeline.self_calibration.enabled) {
+      run.self_calibration_log.push_back(r->self_calibration);
+    }
   }
   run.gate = vo.sunCounters();
   run.vertical_gate = vo.verticalCounters();

@@ -66,7 +66,8 @@ struct FrontendOptions {
   int lr_tolerance = 1;                // px, [0, 10]: left->right->left check for new features
   bool measure_v_right = false;        // subpixel right row of every match whose window
                                        //   determines it (v_right_measured; else v_right =
-                                       //   v_left); what stereo self-calibration needs
+                                       //   v_left), and its column from the same 2-D step;
+                                       //   what stereo self-calibration needs
 
   Status validate() const;
   template <class Self, class V>
@@ -211,7 +212,8 @@ class StereoFrontend {
   // disparity falls outside the range.
   bool refineStereo(int li, int ri, StereoObservation& obs) const;
   // measure_v_right: obs.v_right (and v_right_measured) of left keypoint lk matched at right
-  // column ur and row lk.v + sv (whole pixels), from the current gradient images.
+  // column ur and row lk.v + sv (whole pixels), from the current gradient images; obs.u_right
+  // from the same step when its disparity stays in range.
   void measureRightRow(const Keypoint& lk, int ur, int sv, StereoObservation& obs) const;
 
   FrontendOptions options_;

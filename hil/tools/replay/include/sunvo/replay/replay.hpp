@@ -71,6 +71,7 @@ struct ReplayRun {
   int sun_calls = 0;                                // image estimator calls (every n-th frame)
   std::vector<double> sun_ms;                       // their wall times, ms
   selfcal::SelfCalibrationReport self_calibration;  // after the last frame (if enabled)
+  std::vector<selfcal::SelfCalibrationReport> self_calibration_log;  // per frame (if enabled)
 };
 
 // Opens the dataset of a replay; it must have images. An image estimator gets the colour images
