@@ -74,7 +74,6 @@
 
 #include <ceres/loss_function.h>
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <array>
 #include <memory>
