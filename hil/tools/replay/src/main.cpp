@@ -78,7 +78,8 @@ int main(int argc, char** argv) {
   app.add_flag("--paper-form", paper_form, "hold the base attitude fixed, as the paper did");
   bool vertical = false;
   app.add_flag("--vertical", vertical,
-               "also a run with the vertical vanishing-point cue alone (\"VO+vertical\", no sun)");
+               "also a run with the vertical vanishing-point cue alone (\"VO+vertical\", no sun), "
+               "and each image estimator once more with it");
   bool self_calib = false;
   app.add_flag("--self-calib", self_calib,
                "online stereo self-calibration of the right camera (measures the right rows); its "
@@ -135,19 +136,29 @@ int main(int argc, char** argv) {
   std::vector<sunvo::Isometry3> gt;
   auto estimators = sunvo::sunestimators::makeSunEstimators(estimator_names, model);
   if (!estimators) return sunvo::cli::fail(kProgram, estimators.status());
-  // Runs: pure VO, [VO+vertical], the error-model sources, the image estimators.
-  const std::size_t extra = vertical ? 1 : 0;
-  const std::size_t num_runs = specs.size() + extra + estimators->size();
+  // Runs: pure VO, then with --vertical VO+vertical, the error-model sources, the image
+  // estimators, and with --vertical each image estimator once more with the vertical cue.
+  struct Planned {
+    const sunvo::experiment::SunSourceSpec* spec = nullptr;
+    sunvo::sunfusion::ImageSunEstimator* image = nullptr;
+    bool vertical = false;
+  };
+  std::vector<Planned> plan = {{}};
+  if (vertical) plan.push_back({nullptr, nullptr, true});
+  for (std::size_t i = 1; i < specs.size(); ++i) plan.push_back({&*specs[i], nullptr, false});
+  for (const auto& e : *estimators) plan.push_back({nullptr, e.get(), false});
+  if (vertical) {
+    for (const auto& e : *estimators) plan.push_back({nullptr, e.get(), true});
+  }
   sunvo::replay::ReplayOptions vertical_options = options;
   vertical_options.vertical.enabled = true;
   const Eigen::Vector3d up_w = data->worldUp();
-  for (std::size_t i = 0; i < num_runs; ++i) {
-    const bool image = i >= specs.size() + extra;
-    auto run = image ? sunvo::replay::replayDrive(*data, options, std::nullopt,
-                                                  (*estimators)[i - specs.size() - extra].get())
-               : (vertical && i == 1)
-                   ? sunvo::replay::replayDrive(*data, vertical_options, std::nullopt)
-                   : sunvo::replay::replayDrive(*data, options, specs[i > 0 ? i - extra : 0]);
+  for (std::size_t i = 0; i < plan.size(); ++i) {
+    const Planned& p = plan[i];
+    const sunvo::replay::ReplayOptions& run_options = p.vertical ? vertical_options : options;
+    std::optional<sunvo::experiment::SunSourceSpec> spec;
+    if (p.spec != nullptr) spec = *p.spec;
+    auto run = sunvo::replay::replayDrive(*data, run_options, spec, p.image);
     if (!run) return sunvo::cli::fail(kProgram, run.status());
     // The ground truth of the frames processed (dropped frames have no pose).
     gt.clear();
