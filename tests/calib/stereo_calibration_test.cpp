@@ -253,6 +253,23 @@ TEST(OpenCvStereo, ADamagedMatrixHeaderIsRefusedBeforeOpenCvSizesTheMatrix) {
 #endif
 }
 
+// An indented first key followed by a line indented less made OpenCV 4.6's YAML parser loop
+// forever (found by the short fuzz run of CI, 2026-11-26). It is refused before OpenCV sees it;
+// if the guard were gone, this test would hang and CTest's timeout would fail it.
+TEST(OpenCvStereo, AnIndentedFirstKeyIsRefusedBeforeOpenCvLoopsOnIt) {
+  TempDir dir;
+  for (const char* text : {"%Y\n  A:1.0\n!-=\n\n--\n\n-.K1:1",
+                           "%YAML:1.0\n---\n  A:1.0\n--\n\n-.K1:1", "  M1: [1, 0, 0]\nD1: [0]\n"}) {
+    const std::string path = dir.file("indented.yml");
+    writeText(path, text);
+    const auto c = readOpenCvStereo(path);
+    ASSERT_FALSE(c.hasValue()) << text;
+    EXPECT_NE(c.status().message().find("indented.yml: line "), std::string::npos)
+        << c.status().message();
+    EXPECT_NE(c.status().message().find("column 0"), std::string::npos) << c.status().message();
+  }
+}
+
 TEST(CalibrationFormat, DetectedByContent) {
   TempDir dir;
   const std::string kitti = dir.file("calib_cam_to_cam.txt");

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <initializer_list>
 #include <sstream>
+#include <string_view>
 #include <vector>
 
 namespace sunvo::calib {
@@ -56,6 +57,26 @@ std::size_t firstNonText(const std::string& s) {
     if (c >= 0x7F || (c < 0x20 && c != '\t' && c != '\r' && c != '\n')) return i;
   }
   return std::string::npos;
+}
+
+// 1-based number of the first content line when it is indented, else 0. Content: not blank, not
+// a directive (%), document start (---) or comment (#). OpenCV writes its top-level keys in
+// column 0, and OpenCV 4.6's YAML parser loops forever on an indented first key followed by a
+// line indented less (found by fuzzing: "%YAML:1.0\n  A:1.0\n--\n\n-.K1:1").
+std::size_t indentedFirstKeyLine(const std::string& s) {
+  std::size_t line = 0, begin = 0;
+  while (begin < s.size()) {
+    std::size_t end = s.find('\n', begin);
+    if (end == std::string::npos) end = s.size();
+    ++line;
+    const std::string_view l(s.data() + begin, end - begin);
+    const std::size_t first = l.find_first_not_of(" \t\r");
+    const bool skip = first == std::string_view::npos || l[first] == '%' || l[first] == '#' ||
+                      l.substr(first, 3) == "---";
+    if (!skip) return first > 0 ? line : 0;
+    begin = end + 1;
+  }
+  return 0;
 }
 
 // The numbers of a node: an !!opencv-matrix, a (nested) list, or one number. False if the node
@@ -334,6 +355,13 @@ Expected<RawStereoCalibration> readOpenCvStereo(const std::string& path) {
       first != std::string::npos && (text.compare(first, 5, "%YAML") == 0 ||
                                      text.compare(first, 5, "<?xml") == 0 || text[first] == '{');
   if (!has_signature) text = "%YAML:1.0\n" + text;
+  const std::size_t start = text.find_first_not_of(" \t\r\n");
+  const bool yaml = start != std::string::npos && text.compare(start, 5, "%YAML") == 0;
+  if (const std::size_t line = yaml ? indentedFirstKeyLine(text) : 0; line > 0) {
+    return parseError(fileName(path) + ": line " + std::to_string(has_signature ? line : line - 1) +
+                      ": the first key is indented; an OpenCV YAML file starts its keys in "
+                      "column 0");
+  }
   try {
     cv::FileStorage fs;
     if (!fs.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY)) {
