@@ -52,7 +52,6 @@ Status VerticalEstimator::init(const VerticalOptions& options, const StereoCamer
   lsd_ = cv::createLineSegmentDetector(cv::LSD_REFINE_STD);
   segments_.reserve(4096);
   planes_.reserve(4096);
-  inlier_segments_.reserve(4096);
   return Status::ok();
 }
 
@@ -106,7 +105,6 @@ Expected<VerticalMeasurement> VerticalEstimator::estimate(const cv::Mat& gray,
   const Eigen::Vector3d prior = up_prior_c.normalized();
   VerticalMeasurement out;
   out.up_c = prior;
-  inlier_segments_.clear();
 
   // Scale of the detector's image per axis (its size is rounded, so sx and sy differ slightly).
   double sx = 1.0, sy = 1.0;
@@ -139,9 +137,7 @@ Expected<VerticalMeasurement> VerticalEstimator::estimate(const cv::Mat& gray,
     if (!(norm > 0.0) || !n.allFinite()) continue;
     const Eigen::Vector3d nu = n / norm;
     if (std::abs(nu.dot(prior)) >= tilt_bound) continue;
-    planes_.push_back({nu, len,
-                       cv::Vec4f(static_cast<float>(a.x()), static_cast<float>(a.y()),
-                                 static_cast<float>(b.x()), static_cast<float>(b.y()))});
+    planes_.push_back({nu, len});
   }
   out.candidates = static_cast<int>(planes_.size());
   if (out.candidates < options_.min_inliers) {
@@ -189,9 +185,6 @@ Expected<VerticalMeasurement> VerticalEstimator::estimate(const cv::Mat& gray,
   out.up_c = best;
   out.inliers = inliers;
   out.sigma_rad = std::max(sigma, options_.min_sigma_deg * kDeg);
-  for (const Plane& p : planes_) {
-    if (std::abs(p.n.dot(best)) < inlier_bound) inlier_segments_.push_back(p.seg);
-  }
   if (inliers < options_.min_inliers) {
     out.reason = "too few inliers";
   } else if (out.sigma_rad > options_.max_sigma_deg * kDeg) {

@@ -81,14 +81,10 @@ class VerticalEstimator {
   // valid = false and a reason. Never NaN.
   Expected<VerticalMeasurement> estimate(const cv::Mat& gray, const Eigen::Vector3d& up_prior_c);
 
-  // The segments of the last call's winning hypothesis, full-resolution pixels (for plots).
-  const std::vector<cv::Vec4f>& inlierSegments() const { return inlier_segments_; }
-
  private:
   struct Plane {
     Eigen::Vector3d n;
     double w;
-    cv::Vec4f seg;
   };
   // up = the smallest eigenvector of the weighted scatter of the planes with |n . up| < bound;
   // returns false when fewer than 3 planes qualify.
@@ -100,7 +96,6 @@ class VerticalEstimator {
   cv::Mat small_;
   std::vector<cv::Vec4f> segments_;
   std::vector<Plane> planes_;
-  std::vector<cv::Vec4f> inlier_segments_;
 };
 
 }  // namespace sunvo::vertical
