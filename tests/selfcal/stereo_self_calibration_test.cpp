@@ -152,5 +152,17 @@ TEST(StereoSelfCalibration, OffPassesThroughAndOptionsAreChecked) {
   EXPECT_EQ(cal.init(bad, camera()).message(), "self_calibration.gate_px outside (0, 50] px");
 }
 
+TEST(StereoSelfCalibration, ReportCsvRowMatchesItsHeader) {
+  SelfCalibrationReport r;
+  r.pitch_mrad = -0.15112;
+  r.roll_mrad = -0.78821;
+  r.scale = 0.0006171;
+  r.roll_sigma_mrad = 0.01437;
+  r.used = 207;
+  r.reset = true;
+  EXPECT_STREQ(kReportCsvHeader, "frame,pitch_mrad,roll_mrad,scale,roll_sigma_mrad,used,reset\n");
+  EXPECT_EQ(reportCsvRow(42, r), "42,-0.15112,-0.78821,0.0006171,0.01437,207,1\n");
+}
+
 }  // namespace
 }  // namespace sunvo::selfcal

@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <cstdio>
 
 namespace sunvo::selfcal {
 namespace {
@@ -112,6 +113,13 @@ SelfCalibrationReport StereoSelfCalibration::process(const FrameFeatures& in, Fr
   r.roll_sigma_mrad = std::sqrt(P_(1, 1)) * 1e3;
   r.resets = resets_;
   return r;
+}
+
+std::string reportCsvRow(std::size_t frame, const SelfCalibrationReport& r) {
+  char row[160];
+  std::snprintf(row, sizeof(row), "%zu,%.5f,%.5f,%.7f,%.5f,%d,%d\n", frame, r.pitch_mrad,
+                r.roll_mrad, r.scale, r.roll_sigma_mrad, r.used, r.reset ? 1 : 0);
+  return row;
 }
 
 }  // namespace sunvo::selfcal

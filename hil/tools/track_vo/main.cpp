@@ -130,7 +130,7 @@ int main(int argc, char** argv) {
     return sunvo::cli::fail(kProgram, args.selfcal_log_path + ": cannot open for writing");
   }
   if (selfcal_log != nullptr) {
-    std::fprintf(selfcal_log, "frame,pitch_mrad,roll_mrad,scale,roll_sigma_mrad,used,reset\n");
+    std::fputs(sunvo::selfcal::kReportCsvHeader, selfcal_log);
   }
   std::vector<double> selfcal_ms;
   std::vector<Isometry3> poses;
@@ -160,8 +160,7 @@ int main(int argc, char** argv) {
       const sunvo::selfcal::SelfCalibrationReport& rep = vo.lastSelfCalibration();
       selfcal_ms.push_back(vo.lastSelfCalibrationMs());
       if (selfcal_log != nullptr) {
-        std::fprintf(selfcal_log, "%zu,%.5f,%.5f,%.7f,%.5f,%d,%d\n", k, rep.pitch_mrad,
-                     rep.roll_mrad, rep.scale, rep.roll_sigma_mrad, rep.used, rep.reset ? 1 : 0);
+        std::fputs(sunvo::selfcal::reportCsvRow(k, rep).c_str(), selfcal_log);
       }
     }
     poses.push_back(r->T_w_c);

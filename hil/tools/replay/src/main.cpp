@@ -193,14 +193,9 @@ int main(int argc, char** argv) {
     }
     if (self_calib) {
       // Per frame: OUT/self_calibration_<run>.csv (the right camera's estimate after each frame).
-      std::string csv = "frame,pitch_mrad,roll_mrad,scale,roll_sigma_mrad,used,reset\n";
-      char row[160];
+      std::string csv = sunvo::selfcal::kReportCsvHeader;
       for (std::size_t f = 0; f < run->self_calibration_log.size(); ++f) {
-        const auto& r = run->self_calibration_log[f];
-        std::snprintf(row, sizeof(row), "%zu,%.5f,%.5f,%.7f,%.5f,%d,%d\n", run->frame_index[f],
-                      r.pitch_mrad, r.roll_mrad, r.scale, r.roll_sigma_mrad, r.used,
-                      r.reset ? 1 : 0);
-        csv += row;
+        csv += sunvo::selfcal::reportCsvRow(run->frame_index[f], run->self_calibration_log[f]);
       }
       const std::string path = out_dir + "/self_calibration_" + fileSlug(run->name) + ".csv";
       if (auto s = sunvo::files::writeWholeFile(path, csv); !s.isOk()) {

@@ -22,7 +22,9 @@
 // measured for that frame.
 
 #include <Eigen/Core>
+#include <cstddef>
 #include <cstdint>
+#include <string>
 
 #include "sunvo/core/camera.hpp"
 #include "sunvo/core/features.hpp"
@@ -70,6 +72,12 @@ struct SelfCalibrationReport {
   bool reset = false;            // this frame diverged and was reset
   std::uint64_t resets = 0;      // since init
 };
+
+// The per-frame log of the programs that run it (sunvo_track_vo --self-calib-log, sunvo_replay
+// --self-calib): the CSV header, and the row of frame `frame`; each line ends in '\n'.
+inline constexpr const char* kReportCsvHeader =
+    "frame,pitch_mrad,roll_mrad,scale,roll_sigma_mrad,used,reset\n";
+std::string reportCsvRow(std::size_t frame, const SelfCalibrationReport& r);
 
 class StereoSelfCalibration {
  public:
