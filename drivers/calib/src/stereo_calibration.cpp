@@ -355,8 +355,7 @@ Expected<RawStereoCalibration> readOpenCvStereo(const std::string& path) {
       first != std::string::npos && (text.compare(first, 5, "%YAML") == 0 ||
                                      text.compare(first, 5, "<?xml") == 0 || text[first] == '{');
   if (!has_signature) text = "%YAML:1.0\n" + text;
-  const std::size_t start = text.find_first_not_of(" \t\r\n");
-  const bool yaml = start != std::string::npos && text.compare(start, 5, "%YAML") == 0;
+  const bool yaml = !has_signature || text.compare(first, 5, "%YAML") == 0;
   if (const std::size_t line = yaml ? indentedFirstKeyLine(text) : 0; line > 0) {
     return parseError(fileName(path) + ": line " + std::to_string(has_signature ? line : line - 1) +
                       ": the first key is indented; an OpenCV YAML file starts its keys in "
