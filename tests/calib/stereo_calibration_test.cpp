@@ -37,22 +37,25 @@ void writeOpenCv(const std::string& path, const char* k1_key, bool with_d2 = tru
   fs << "image_width" << 640 << "image_height" << 480;
 }
 
+// YAML and JSON go through yaml-cpp, XML through cv::FileStorage: all three as OpenCV writes them.
 TEST(OpenCvStereo, ReadsWhatFileStorageWrote) {
   TempDir dir;
-  for (const char* key : {"K1", "M1", "cameraMatrix1"}) {
-    const std::string path = dir.file(std::string("rig_") + key + ".yaml");
-    writeOpenCv(path, key);
-    auto c = readOpenCvStereo(path);
-    ASSERT_TRUE(c.hasValue()) << key << ": " << c.status().toString();
-    EXPECT_EQ(c->size, cv::Size(640, 480));
-    EXPECT_EQ(c->model, DistortionModel::kRadTan);
-    EXPECT_LT(cv::norm(c->K_left - kK1), 1e-12);
-    EXPECT_LT(cv::norm(c->K_right - kK2), 1e-12);
-    EXPECT_LT(cv::norm(c->C_r_l - kR), 1e-12);
-    EXPECT_LT(cv::norm(c->t_r_l - kT), 1e-12);
-    ASSERT_EQ(c->D_left.total(), 5u);
-    EXPECT_DOUBLE_EQ(c->D_left.at<double>(0, 0), -0.1);
-    EXPECT_DOUBLE_EQ(c->D_right.at<double>(0, 3), 0.001);
+  for (const char* ext : {".yaml", ".json", ".xml"}) {
+    for (const char* key : {"K1", "M1", "cameraMatrix1"}) {
+      const std::string path = dir.file(std::string("rig_") + key + ext);
+      writeOpenCv(path, key);
+      auto c = readOpenCvStereo(path);
+      ASSERT_TRUE(c.hasValue()) << key << ext << ": " << c.status().toString();
+      EXPECT_EQ(c->size, cv::Size(640, 480));
+      EXPECT_EQ(c->model, DistortionModel::kRadTan);
+      EXPECT_LT(cv::norm(c->K_left - kK1), 1e-12);
+      EXPECT_LT(cv::norm(c->K_right - kK2), 1e-12);
+      EXPECT_LT(cv::norm(c->C_r_l - kR), 1e-12);
+      EXPECT_LT(cv::norm(c->t_r_l - kT), 1e-12);
+      ASSERT_EQ(c->D_left.total(), 5u);
+      EXPECT_DOUBLE_EQ(c->D_left.at<double>(0, 0), -0.1);
+      EXPECT_DOUBLE_EQ(c->D_right.at<double>(0, 3), 0.001);
+    }
   }
 }
 
@@ -253,21 +256,35 @@ TEST(OpenCvStereo, ADamagedMatrixHeaderIsRefusedBeforeOpenCvSizesTheMatrix) {
 #endif
 }
 
-// An indented first key followed by a line indented less made OpenCV 4.6's YAML parser loop
-// forever (found by the short fuzz run of CI, 2026-11-26). It is refused before OpenCV sees it;
-// if the guard were gone, this test would hang and CTest's timeout would fail it.
-TEST(OpenCvStereo, AnIndentedFirstKeyIsRefusedBeforeOpenCvLoopsOnIt) {
+// Inputs on which OpenCV 4.6's YAML parser never returned (found by fuzzing, 2026-11-26): an
+// indented first key followed by a line indented less, and a stream of "---" markers
+// (tests/calib/data/fuzz_hang_document_markers.yaml). YAML no longer reaches that parser; each is
+// an error naming the file. If it did, this test would hang and CTest's timeout would fail it.
+TEST(OpenCvStereo, InputsThatMadeOpenCvsYamlParserLoopAreErrors) {
   TempDir dir;
   for (const char* text : {"%Y\n  A:1.0\n!-=\n\n--\n\n-.K1:1",
                            "%YAML:1.0\n---\n  A:1.0\n--\n\n-.K1:1", "  M1: [1, 0, 0]\nD1: [0]\n"}) {
-    const std::string path = dir.file("indented.yml");
+    const std::string path = dir.file("loop.yml");
     writeText(path, text);
     const auto c = readOpenCvStereo(path);
     ASSERT_FALSE(c.hasValue()) << text;
-    EXPECT_NE(c.status().message().find("indented.yml: line "), std::string::npos)
-        << c.status().message();
-    EXPECT_NE(c.status().message().find("column 0"), std::string::npos) << c.status().message();
+    EXPECT_EQ(c.status().message().rfind("loop.yml: ", 0), 0u) << c.status().message();
   }
+  const auto c = readOpenCvStereo(std::string(SUNVO_SOURCE_DIR) +
+                                  "/tests/calib/data/fuzz_hang_document_markers.yaml");
+  ASSERT_FALSE(c.hasValue());
+  EXPECT_EQ(c.status().message().rfind("fuzz_hang_document_markers.yaml: line ", 0), 0u)
+      << c.status().message();
+}
+
+// A YAML syntax error names the line of the file, counting OpenCV's "%YAML:1.0" line.
+TEST(OpenCvStereo, AYamlSyntaxErrorNamesTheLine) {
+  TempDir dir;
+  const std::string path = dir.file("syntax.yaml");
+  writeText(path, "%YAML:1.0\n---\nK1: [700, 0, 320, 0, 700, 240, 0, 0, 1]\nK2: [700, 0}\nR: 1\n");
+  const auto c = readOpenCvStereo(path);
+  ASSERT_FALSE(c.hasValue());
+  EXPECT_EQ(c.status().message().rfind("syntax.yaml: line 4: ", 0), 0u) << c.status().message();
 }
 
 TEST(CalibrationFormat, DetectedByContent) {

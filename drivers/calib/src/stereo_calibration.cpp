@@ -5,8 +5,10 @@
 #include <cmath>
 #include <fstream>
 #include <initializer_list>
+#include <optional>
 #include <sstream>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace sunvo::calib {
@@ -46,11 +48,11 @@ cv::Matx33d toMatx33(const std::vector<double>& v) {
   return m;
 }
 
-// --- OpenCV FileStorage ------------------------------------------------------------------------
+// --- OpenCV stereo files --------------------------------------------------------------------
 
-// Offset of the first byte that is not printable ASCII, tab, CR or LF, or npos. OpenCV 4.6's
-// YAML parser loops forever on bytes >= 0x80 (found twice by fuzzing: a 0xFF run, and a
-// well-formed 4-byte UTF-8 character), so only ASCII reaches it.
+// Offset of the first byte that is not printable ASCII, tab, CR or LF, or npos. Calibration files
+// are ASCII; OpenCV 4.6's parsers loop forever on bytes >= 0x80 (found twice by fuzzing), so
+// only ASCII reaches them.
 std::size_t firstNonText(const std::string& s) {
   for (std::size_t i = 0; i < s.size(); ++i) {
     const auto c = static_cast<unsigned char>(s[i]);
@@ -59,69 +61,162 @@ std::size_t firstNonText(const std::string& s) {
   return std::string::npos;
 }
 
-// 1-based number of the first content line when it is indented, else 0. Content: not blank, not
-// a directive (%), document start (---) or comment (#). OpenCV writes its top-level keys in
-// column 0, and OpenCV 4.6's YAML parser loops forever on an indented first key followed by a
-// line indented less (found by fuzzing: "%YAML:1.0\n  A:1.0\n--\n\n-.K1:1").
-std::size_t indentedFirstKeyLine(const std::string& s) {
-  std::size_t line = 0, begin = 0;
-  while (begin < s.size()) {
-    std::size_t end = s.find('\n', begin);
-    if (end == std::string::npos) end = s.size();
-    ++line;
-    const std::string_view l(s.data() + begin, end - begin);
-    const std::size_t first = l.find_first_not_of(" \t\r");
-    const bool skip = first == std::string_view::npos || l[first] == '%' || l[first] == '#' ||
-                      l.substr(first, 3) == "---";
-    if (!skip) return first > 0 ? line : 0;
-    begin = end + 1;
-  }
-  return 0;
+// The top-level keys of an OpenCV stereo file, whichever parser read it. YAML and JSON go to
+// yaml-cpp; only XML goes to cv::FileStorage. OpenCV 4.6's YAML parser loops forever on inputs
+// a fuzzer finds within a minute (an indented first key, a stream of "---" markers; see
+// docs/hardening.md), and a guard per shape never closes that family.
+class Fields {
+ public:
+  virtual ~Fields() = default;
+  virtual bool has(const char* key) const = 0;
+  // The numbers under key, row-major: an !!opencv-matrix, a (nested) list or one number. False
+  // if the node holds anything else.
+  virtual bool numbers(const char* key, std::vector<double>* out) const = 0;
+  // A scalar's text, or nothing if the node is not a string.
+  virtual std::optional<std::string> text(const char* key) const = 0;
+  // An integer, or nothing if the node is not one.
+  virtual std::optional<int> integer(const char* key) const = 0;
+};
+
+// An !!opencv-matrix header is checked before its data is read: OpenCV sizes the matrix from
+// rows and cols as they stand, and a damaged header made it ask for 48 GB (found by fuzzing).
+constexpr int kMaxMatrixSide = 64;  // a calibration matrix or distortion vector is far smaller
+
+bool matrixShapeOk(int rows, int cols, std::size_t data_size) {
+  return rows >= 1 && rows <= kMaxMatrixSide && cols >= 1 && cols <= kMaxMatrixSide &&
+         data_size == static_cast<std::size_t>(rows) * static_cast<std::size_t>(cols);
 }
 
-// The numbers of a node: an !!opencv-matrix, a (nested) list, or one number. False if the node
-// holds anything else.
-bool numbersOf(const cv::FileNode& n, std::vector<double>* out) {
-  if (n.isMap()) {
-    // The header is checked before OpenCV reads the matrix: it sizes the matrix from rows and
-    // cols as they stand, and a damaged header made it ask for 48 GB (found by fuzzing).
-    constexpr int kMaxSide = 64;  // a calibration matrix or distortion vector is far smaller
-    const cv::FileNode rows = n["rows"];
-    const cv::FileNode cols = n["cols"];
-    const cv::FileNode data = n["data"];
-    if (!rows.isInt() || !cols.isInt() || !data.isSeq()) return false;
-    const int r = static_cast<int>(rows);
-    const int c = static_cast<int>(cols);
-    if (r < 1 || r > kMaxSide || c < 1 || c > kMaxSide ||
-        data.size() != static_cast<std::size_t>(r) * static_cast<std::size_t>(c)) {
-      return false;
-    }
-    cv::Mat m;
-    cv::read(n, m);
-    if (m.empty()) return false;
-    cv::Mat d;
-    m.convertTo(d, CV_64F);
-    d = d.reshape(1, 1);
-    out->assign(d.begin<double>(), d.end<double>());
-    return true;
-  }
-  if (n.isSeq()) {
-    for (const cv::FileNode& e : n) {
-      if (!numbersOf(e, out)) return false;
-    }
-    return true;
-  }
-  if (n.isInt() || n.isReal()) {
-    out->push_back(static_cast<double>(n));
-    return true;
-  }
-  return false;
-}
+class YamlFields final : public Fields {
+ public:
+  explicit YamlFields(YAML::Node root) : root_(std::move(root)) {}
 
-// The first of `names` present in fs; empty if none.
-std::string firstKey(const cv::FileStorage& fs, std::initializer_list<const char*> names) {
+  bool has(const char* key) const override { return static_cast<bool>(root_[key]); }
+
+  bool numbers(const char* key, std::vector<double>* out) const override {
+    const YAML::Node n = root_[key];
+    return n && numbersOf(n, 0, out);
+  }
+
+  std::optional<std::string> text(const char* key) const override {
+    const YAML::Node n = root_[key];
+    if (!n || !n.IsScalar()) return std::nullopt;
+    return n.Scalar();
+  }
+
+  std::optional<int> integer(const char* key) const override {
+    const YAML::Node n = root_[key];
+    int v = 0;
+    if (!n || !n.IsScalar() || !YAML::convert<int>::decode(n, v)) return std::nullopt;
+    return v;
+  }
+
+ private:
+  static bool number(const YAML::Node& n, std::vector<double>* out) {
+    double v = 0.0;
+    if (!n.IsScalar() || !YAML::convert<double>::decode(n, v)) return false;
+    out->push_back(v);
+    return true;
+  }
+
+  // depth: calibration lists nest two deep at most ([[fx, 0, cx], ...]).
+  static bool numbersOf(const YAML::Node& n, int depth, std::vector<double>* out) {
+    if (n.IsMap()) {
+      const YAML::Node rows = n["rows"];
+      const YAML::Node cols = n["cols"];
+      const YAML::Node data = n["data"];
+      const YAML::Node dt = n["dt"];
+      int r = 0, c = 0;
+      if (!rows || !cols || !data || !rows.IsScalar() || !cols.IsScalar() || !data.IsSequence() ||
+          !YAML::convert<int>::decode(rows, r) || !YAML::convert<int>::decode(cols, c) ||
+          !matrixShapeOk(r, c, data.size())) {
+        return false;
+      }
+      // OpenCV's one-channel element types; a matrix of another type is not a calibration.
+      if (dt && !(dt.IsScalar() && dt.Scalar().size() == 1 &&
+                  std::string_view("ucwsifd").find(dt.Scalar()[0]) != std::string_view::npos)) {
+        return false;
+      }
+      for (const YAML::Node& e : data) {
+        if (!number(e, out)) return false;
+      }
+      return true;
+    }
+    if (n.IsSequence()) {
+      if (depth >= 2) return false;
+      for (const YAML::Node& e : n) {
+        if (!numbersOf(e, depth + 1, out)) return false;
+      }
+      return true;
+    }
+    return number(n, out);
+  }
+
+  YAML::Node root_;
+};
+
+// OpenCV XML, through cv::FileStorage (which may throw cv::Exception).
+class CvFields final : public Fields {
+ public:
+  explicit CvFields(const cv::FileStorage& fs) : fs_(fs) {}
+
+  bool has(const char* key) const override { return !fs_[key].empty(); }
+
+  bool numbers(const char* key, std::vector<double>* out) const override {
+    return numbersOf(fs_[key], out);
+  }
+
+  std::optional<std::string> text(const char* key) const override {
+    const cv::FileNode n = fs_[key];
+    if (!n.isString()) return std::nullopt;
+    return n.string();
+  }
+
+  std::optional<int> integer(const char* key) const override {
+    const cv::FileNode n = fs_[key];
+    if (!n.isInt()) return std::nullopt;
+    return static_cast<int>(n);
+  }
+
+ private:
+  static bool numbersOf(const cv::FileNode& n, std::vector<double>* out) {
+    if (n.isMap()) {
+      const cv::FileNode rows = n["rows"];
+      const cv::FileNode cols = n["cols"];
+      const cv::FileNode data = n["data"];
+      if (!rows.isInt() || !cols.isInt() || !data.isSeq() ||
+          !matrixShapeOk(static_cast<int>(rows), static_cast<int>(cols), data.size())) {
+        return false;
+      }
+      cv::Mat m;
+      cv::read(n, m);
+      if (m.empty()) return false;
+      cv::Mat d;
+      m.convertTo(d, CV_64F);
+      d = d.reshape(1, 1);
+      out->insert(out->end(), d.begin<double>(), d.end<double>());
+      return true;
+    }
+    if (n.isSeq()) {
+      for (const cv::FileNode& e : n) {
+        if (!numbersOf(e, out)) return false;
+      }
+      return true;
+    }
+    if (n.isInt() || n.isReal()) {
+      out->push_back(static_cast<double>(n));
+      return true;
+    }
+    return false;
+  }
+
+  const cv::FileStorage& fs_;
+};
+
+// The first of `names` present; empty if none.
+std::string firstKey(const Fields& f, std::initializer_list<const char*> names) {
   for (const char* n : names) {
-    if (!fs[n].empty()) return n;
+    if (f.has(n)) return n;
   }
   return {};
 }
@@ -133,13 +228,13 @@ std::string spellings(std::initializer_list<const char*> names) {
 }
 
 // Reads one of `names` with one of `counts` numbers.
-Status readNumbers(const cv::FileStorage& fs, const std::string& path,
+Status readNumbers(const Fields& f, const std::string& path,
                    std::initializer_list<const char*> names, std::initializer_list<int> counts,
                    std::vector<double>* out) {
-  const std::string key = firstKey(fs, names);
+  const std::string key = firstKey(f, names);
   if (key.empty()) return keyError(path, spellings(names), "missing");
   out->clear();
-  if (!numbersOf(fs[key], out)) return keyError(path, key, "expected numbers");
+  if (!f.numbers(key.c_str(), out)) return keyError(path, key, "expected numbers");
   bool count_ok = false;
   for (const int c : counts) count_ok = count_ok || static_cast<int>(out->size()) == c;
   if (!count_ok) {
@@ -151,18 +246,20 @@ Status readNumbers(const cv::FileStorage& fs, const std::string& path,
   return Status::ok();
 }
 
-Status readImageSize(const cv::FileStorage& fs, const std::string& path, cv::Size* size) {
+Status readImageSize(const Fields& f, const std::string& path, cv::Size* size) {
   for (const auto& [w, h] :
        {std::pair<const char*, const char*>{"image_width", "image_height"}, {"width", "height"}}) {
-    if (fs[w].empty() && fs[h].empty()) continue;
-    if (!fs[w].isInt()) return keyError(path, w, "expected an integer");
-    if (!fs[h].isInt()) return keyError(path, h, "expected an integer");
-    *size = cv::Size(static_cast<int>(fs[w]), static_cast<int>(fs[h]));
+    if (!f.has(w) && !f.has(h)) continue;
+    const std::optional<int> width = f.integer(w);
+    if (!width) return keyError(path, w, "expected an integer");
+    const std::optional<int> height = f.integer(h);
+    if (!height) return keyError(path, h, "expected an integer");
+    *size = cv::Size(*width, *height);
     return Status::ok();
   }
   std::vector<double> wh;
   const Status s = readNumbers(
-      fs, path, {"image_size", "imageSize", "size", "image_width + image_height", "width + height"},
+      f, path, {"image_size", "imageSize", "size", "image_width + image_height", "width + height"},
       {2}, &wh);
   if (!s.isOk()) return s;
   *size = cv::Size(static_cast<int>(std::lround(wh[0])), static_cast<int>(std::lround(wh[1])));
@@ -187,31 +284,31 @@ cv::Mat rowOf(const std::vector<double>& v) {
   return cv::Mat(1, static_cast<int>(v.size()), CV_64F, const_cast<double*>(v.data())).clone();
 }
 
-// Every key of an OpenCV stereo file into c (may throw cv::Exception).
-Status readOpenCvFields(const cv::FileStorage& fs, const std::string& path,
-                        RawStereoCalibration* c) {
+// Every key of an OpenCV stereo file into c (may throw cv::Exception or YAML::Exception).
+Status readOpenCvFields(const Fields& f, const std::string& path, RawStereoCalibration* c) {
   std::vector<double> v;
   SUNVO_RETURN_IF_ERROR(
-      readNumbers(fs, path, {"K1", "M1", "cameraMatrix1", "camera_matrix_left"}, {9}, &v));
+      readNumbers(f, path, {"K1", "M1", "cameraMatrix1", "camera_matrix_left"}, {9}, &v));
   c->K_left = toMatx33(v);
   SUNVO_RETURN_IF_ERROR(
-      readNumbers(fs, path, {"K2", "M2", "cameraMatrix2", "camera_matrix_right"}, {9}, &v));
+      readNumbers(f, path, {"K2", "M2", "cameraMatrix2", "camera_matrix_right"}, {9}, &v));
   c->K_right = toMatx33(v);
-  if (const cv::FileNode m = fs["distortion_model"]; !m.empty()) {
-    if (!m.isString()) return keyError(path, "distortion_model", "expected a name");
-    SUNVO_RETURN_IF_ERROR(readModel(path, "distortion_model", m.string(), &c->model));
+  if (f.has("distortion_model")) {
+    const std::optional<std::string> m = f.text("distortion_model");
+    if (!m) return keyError(path, "distortion_model", "expected a name");
+    SUNVO_RETURN_IF_ERROR(readModel(path, "distortion_model", *m, &c->model));
   }
   SUNVO_RETURN_IF_ERROR(
-      readNumbers(fs, path, {"D1", "distCoeffs1", "dist_coeffs_left"}, {4, 5, 8, 12, 14}, &v));
+      readNumbers(f, path, {"D1", "distCoeffs1", "dist_coeffs_left"}, {4, 5, 8, 12, 14}, &v));
   c->D_left = rowOf(v);
   SUNVO_RETURN_IF_ERROR(
-      readNumbers(fs, path, {"D2", "distCoeffs2", "dist_coeffs_right"}, {4, 5, 8, 12, 14}, &v));
+      readNumbers(f, path, {"D2", "distCoeffs2", "dist_coeffs_right"}, {4, 5, 8, 12, 14}, &v));
   c->D_right = rowOf(v);
-  SUNVO_RETURN_IF_ERROR(readNumbers(fs, path, {"R"}, {9}, &v));
+  SUNVO_RETURN_IF_ERROR(readNumbers(f, path, {"R"}, {9}, &v));
   c->C_r_l = toMatx33(v);
-  SUNVO_RETURN_IF_ERROR(readNumbers(fs, path, {"T"}, {3}, &v));
+  SUNVO_RETURN_IF_ERROR(readNumbers(f, path, {"T"}, {3}, &v));
   c->t_r_l = cv::Vec3d(v[0], v[1], v[2]);
-  return readImageSize(fs, path, &c->size);
+  return readImageSize(f, path, &c->size);
 }
 
 // --- Kalibr (yaml-cpp) -------------------------------------------------------------------------
@@ -336,43 +433,45 @@ Status RawStereoCalibration::validate() const {
 Expected<RawStereoCalibration> readOpenCvStereo(const std::string& path) {
   RawStereoCalibration c;
   c.file = path;
-  // cv::FileStorage throws on a malformed file and on a malformed !!opencv-matrix (bad dt,
-  // data that does not fit rows x cols): an error naming the file, never an exception out.
   std::ifstream in(path, std::ios::binary);
   if (!in) return ioError(path + ": cannot open");
   std::ostringstream whole;
   whole << in.rdbuf();
   std::string text = whole.str();
-  // Only ASCII text reaches OpenCV's parser (see firstNonText).
   if (const std::size_t bad = firstNonText(text); bad != std::string::npos) {
     return parseError(fileName(path) + ": byte " + std::to_string(bad) +
                       " is not ASCII text (OpenCV calibration files are ASCII)");
   }
-  // OpenCV 4.6 reads YAML only after a "%YAML" line ("Input file is invalid" otherwise); a
-  // hand-written file without one is read as YAML too.
   const std::size_t first = text.find_first_not_of(" \t\r\n");
-  const bool has_signature =
-      first != std::string::npos && (text.compare(first, 5, "%YAML") == 0 ||
-                                     text.compare(first, 5, "<?xml") == 0 || text[first] == '{');
-  if (!has_signature) text = "%YAML:1.0\n" + text;
-  const bool yaml = !has_signature || text.compare(first, 5, "%YAML") == 0;
-  if (const std::size_t line = yaml ? indentedFirstKeyLine(text) : 0; line > 0) {
-    return parseError(fileName(path) + ": line " + std::to_string(has_signature ? line : line - 1) +
-                      ": the first key is indented; an OpenCV YAML file starts its keys in "
-                      "column 0");
-  }
   try {
-    cv::FileStorage fs;
-    if (!fs.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY)) {
-      return parseError(fileName(path) + ": not a readable OpenCV YAML/XML file");
+    if (first != std::string::npos && text.compare(first, 5, "<?xml") == 0) {
+      cv::FileStorage fs;
+      if (!fs.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY)) {
+        return parseError(fileName(path) + ": not a readable OpenCV XML file");
+      }
+      SUNVO_RETURN_IF_ERROR(readOpenCvFields(CvFields(fs), path, &c));
+    } else {
+      // OpenCV writes "%YAML:1.0", which is not a YAML directive; it becomes a comment, so
+      // line numbers stay those of the file. A file without it is read the same way.
+      if (first != std::string::npos && text.compare(first, 6, "%YAML:") == 0) text[first] = '#';
+      YAML::Node root;
+      try {
+        root = YAML::Load(text);
+      } catch (const YAML::Exception& e) {
+        return parseError(fileName(path) + ": line " + std::to_string(e.mark.line + 1) +
+                          ": not a readable OpenCV YAML file: " + e.msg);
+      }
+      if (!root.IsMap()) {
+        return parseError(fileName(path) + ": not an OpenCV stereo file (no map of keys)");
+      }
+      SUNVO_RETURN_IF_ERROR(readOpenCvFields(YamlFields(root), path, &c));
     }
-    SUNVO_RETURN_IF_ERROR(readOpenCvFields(fs, path, &c));
   } catch (const cv::Exception& e) {
-    return parseError(fileName(path) + ": not a readable OpenCV YAML/XML file: " + e.msg);
+    return parseError(fileName(path) + ": not a readable OpenCV file: " + e.msg);
   } catch (const std::exception& e) {
     // FileStorage also lets standard exceptions out (std::length_error on a damaged matrix
-    // header; found by fuzzing).
-    return parseError(fileName(path) + ": not a readable OpenCV YAML/XML file: " + e.what());
+    // header; found by fuzzing); YAML::Exception derives from std::runtime_error.
+    return parseError(fileName(path) + ": not a readable OpenCV file: " + e.what());
   }
   const Status s = c.validate();
   if (!s.isOk()) return s;

@@ -2,9 +2,11 @@
 // The raw (unrectified) calibration of a stereo rig, read from the files that calibration tools
 // write. Two formats:
 //
-// OpenCV stereo YAML, read with cv::FileStorage (the layout of OpenCV's stereo_calib sample and
-// of most scripts around cv::stereoCalibrate; a YAML file without the "%YAML" line OpenCV wants
-// is read too). Matrices as !!opencv-matrix or as flat lists of numbers, row-major. Accepted keys
+// OpenCV stereo YAML, JSON or XML as cv::FileStorage writes them (the layout of OpenCV's
+// stereo_calib sample and of most scripts around cv::stereoCalibrate; a YAML file without the
+// "%YAML" line is read too). YAML and JSON are parsed with yaml-cpp, XML with cv::FileStorage:
+// OpenCV 4.6's own YAML parser can loop forever on damaged input (docs/hardening.md).
+// Matrices as !!opencv-matrix or as flat lists of numbers, row-major. Accepted keys
 // (the first spelling present wins):
 //   left intrinsics   K1 | M1 | cameraMatrix1 | camera_matrix_left      3x3
 //   left distortion   D1 | distCoeffs1 | dist_coeffs_left               4, 5, 8, 12 or 14 values
@@ -26,7 +28,7 @@
 // Frames: camera x right, y down, z forward (both files use it). The right camera's centre in
 // the left frame is -R^T T; a rectifiable pair has it mostly along +x (calib::StereoRectifier).
 // Every error names the file and the key ("rig.yaml: D1: expected 4, 5, 8, 12 or 14 values,
-// found 3"); the Kalibr reader adds the line.
+// found 3"); a YAML syntax error and every Kalibr error also name the line.
 
 #include <opencv2/core.hpp>
 #include <span>
