@@ -81,6 +81,48 @@ TEST(SimulatedSunSource, AzimuthOnlyLiesInThePlaneAndIsReproducible) {
   }
 }
 
+// The correlated azimuth error: its std and its autocorrelation at lags 1 and tau are those of the
+// Gauss-Markov process, and it is the only difference to the same source without it (its own
+// generator leaves the other draws alone).
+TEST(SimulatedSunSource, CorrelatedAzimuthBiasIsAGaussMarkovProcessOnTop) {
+  SunErrorModel plain;
+  plain.azimuth_sigma_deg = 10.0;
+  plain.dropout_share = 0.2;
+  SunErrorModel biased = plain;
+  biased.azimuth_bias_deg = 6.0;
+  biased.azimuth_bias_length = 20.0;
+  ASSERT_TRUE(biased.validate().isOk());
+  SimulatedSunSource a(biased), b(plain);
+  const Eigen::Vector3d truth = sunFromAzimuthZenith(10.0 * kDeg, 60.0 * kDeg);
+  constexpr int kN = 100000;
+  std::vector<double> bias(kN);
+  for (int i = 0; i < kN; ++i) {
+    const auto ma = a.measure(static_cast<std::uint64_t>(i), 0, truth);
+    const auto mb = b.measure(static_cast<std::uint64_t>(i), 0, truth);
+    bias[static_cast<std::size_t>(i)] = a.azimuthBias();
+    ASSERT_EQ(ma.has_value(), mb.has_value());
+    if (!ma) continue;
+    double az_a = 0, az_b = 0, z = 0;
+    azimuthZenithFromSun(ma->sun_c, az_a, z);
+    azimuthZenithFromSun(mb->sun_c, az_b, z);
+    ASSERT_NEAR(wrap(az_a - az_b - a.azimuthBias()), 0.0, 1e-9) << i;
+  }
+  const auto lagged = [&](int lag) {
+    double sum = 0.0;
+    for (int i = lag; i < kN; ++i) {
+      sum += bias[static_cast<std::size_t>(i)] * bias[static_cast<std::size_t>(i - lag)];
+    }
+    return sum / (kN - lag);
+  };
+  const double var = lagged(0);
+  EXPECT_NEAR(std::sqrt(var) / kDeg, 6.0, 0.3);
+  EXPECT_NEAR(lagged(1) / var, std::exp(-1.0 / 20.0), 0.01);
+  EXPECT_NEAR(lagged(20) / var, std::exp(-1.0), 0.05);
+  SunErrorModel bad = biased;
+  bad.azimuth_bias_length = 0.5;
+  EXPECT_NE(bad.validate().message().find("sun_error.azimuth_bias_length"), std::string::npos);
+}
+
 TEST(SimulatedVerticalSource, ErrorsDropoutsOutliersAndBiasAsModelled) {
   // Truth: a camera rolled by 3 deg. The pitch error (about camera x) and roll error (about z) of
   // each measurement: mean = bias, std = sigma; 8 deg outliers; dropouts.

@@ -30,6 +30,12 @@ Status SunErrorModel::validate() const {
   if (!(reported_sigma > 0.0 && reported_sigma <= 2.0)) {
     return invalidArgument("sun_error.reported_sigma out of range (0, 2]");
   }
+  if (!(azimuth_bias_deg >= 0.0 && azimuth_bias_deg <= 90.0)) {
+    return invalidArgument("sun_error.azimuth_bias_deg out of range [0, 90]");
+  }
+  if (!(azimuth_bias_length >= 1.0 && azimuth_bias_length <= 1e6)) {
+    return invalidArgument("sun_error.azimuth_bias_length out of range [1, 1e6]");
+  }
   return Status::ok();
 }
 
@@ -101,6 +107,15 @@ std::optional<SunMeasurement> SimulatedSunSource::measure(std::uint64_t sequence
   const double u_drop = unit(rng_), u_out = unit(rng_), u_flip = unit(rng_);
   const double out_az = unit(rng_), out_zen = unit(rng_);
   const double n_az = normal(rng_), n_zen = normal(rng_);
+  if (model_.azimuth_bias_deg > 0.0) {
+    // The stationary start, then one Gauss-Markov step per call (see the header).
+    const double sigma_b = model_.azimuth_bias_deg * kDeg;
+    const double n_b = normal(bias_rng_);
+    const double phi = std::exp(-1.0 / model_.azimuth_bias_length);
+    bias_ =
+        bias_started_ ? phi * bias_ + std::sqrt(1.0 - phi * phi) * sigma_b * n_b : sigma_b * n_b;
+    bias_started_ = true;
+  }
   if (u_drop < model_.dropout_share) return std::nullopt;
 
   double az = 0.0, zen = 0.0;
@@ -110,7 +125,7 @@ std::optional<SunMeasurement> SimulatedSunSource::measure(std::uint64_t sequence
     zen = std::acos(out_zen);  // uniform over the upper hemisphere's solid angle
   } else {
     if (u_flip < model_.flip_share) az += M_PI;
-    az += n_az * model_.azimuth_sigma_deg * kDeg;
+    az += n_az * model_.azimuth_sigma_deg * kDeg + bias_;
     zen += (model_.zenith_bias_deg + n_zen * model_.zenith_sigma_deg) * kDeg;
     zen = std::clamp(zen, 0.0, M_PI);
   }

@@ -28,14 +28,24 @@ double chiSquareCdf(double x, int dof) {
 }
 
 // The sun residual of a measurement against the sun in the base frame: 3-D or azimuth-only, on
-// C_k_b alone (the paper's form) or also on the base correction delta_b.
+// C_k_b alone (the paper's form) or also on the base correction delta_b, and with b_hat also on
+// the azimuth bias's correction (b_hat: the bias estimate, or null).
 std::unique_ptr<ceres::CostFunction> makeSunCost(const Eigen::Vector3d& sun_b,
-                                                 const SunMeasurement& m, bool base_correction) {
+                                                 const SunMeasurement& m, bool base_correction,
+                                                 const double* b_hat = nullptr) {
   if (m.kind == SunMeasurementKind::kAzimuthOnly) {
     const Eigen::Vector2d xz = xzDirection(m.sun_c);
+    if (b_hat != nullptr) {
+      return std::unique_ptr<ceres::CostFunction>(
+          SunAzimuthResidual::CreateWithBaseCorrectionAndBias(sun_b, xz, m.sigma, *b_hat));
+    }
     return std::unique_ptr<ceres::CostFunction>(
         base_correction ? SunAzimuthResidual::CreateWithBaseCorrection(sun_b, xz, m.sigma)
                         : SunAzimuthResidual::Create(sun_b, xz, m.sigma));
+  }
+  if (b_hat != nullptr) {
+    return std::unique_ptr<ceres::CostFunction>(
+        SunDirectionResidual::CreateWithBaseCorrectionAndBias(sun_b, m.sun_c, m.sigma, *b_hat));
   }
   return std::unique_ptr<ceres::CostFunction>(
       base_correction ? SunDirectionResidual::CreateWithBaseCorrection(sun_b, m.sun_c, m.sigma)
@@ -108,6 +118,12 @@ Status SunFusionOptions::validate() const {
   if (!(max_correction_deg >= 0.0 && max_correction_deg <= 180.0)) {
     return invalidArgument("fusion.max_correction_deg out of range [0, 180]");
   }
+  if (!(sun_bias_sigma_deg >= 0.0 && sun_bias_sigma_deg <= 45.0)) {
+    return invalidArgument("fusion.sun_bias_sigma_deg out of range [0, 45]");
+  }
+  if (!(sun_bias_length_frames >= 1.0 && sun_bias_length_frames <= 1e6)) {
+    return invalidArgument("fusion.sun_bias_length_frames out of range [1, 1e6]");
+  }
   return Status::ok();
 }
 
@@ -123,6 +139,10 @@ Status SunWindowTerm::init(const SunFusionOptions& options) {
   delta_ = {0.0, 0.0, 0.0};
   const double s0 = options.initial_attitude_sigma_deg * kDeg;
   P_ = Eigen::Matrix3d::Identity() * s0 * s0;
+  bias_ = 0.0;
+  bias_delta_ = 0.0;
+  P_bb_ = biasEnabled() ? std::pow(options.sun_bias_sigma_deg * kDeg, 2) : 0.0;
+  P_tb_.setZero();
   drift_deg_per_frame_ = options.drift_adaptation == DriftAdaptation::kEvidence
                              ? options.min_drift_deg_per_frame
                              : options.attitude_drift_deg_per_frame;
@@ -176,11 +196,15 @@ Status SunWindowTerm::onSolve(backend::BundleWindow& window) {
   }
   last_sequence_ = newest;
   delta_ = {0.0, 0.0, 0.0};
+  bias_delta_ = 0.0;
   num_used_ = 0;
 
-  // Prior of this solve's base correction delta_b = C_b_w dtheta_w: N(0, C_b_w P_theta C_w_b).
+  // Prior of this solve's base correction delta_b = C_b_w dtheta_w: N(0, C_b_w P_theta C_w_b),
+  // jointly with the bias correction db ~ N(0, P_bb) when the bias is a state.
   const Eigen::Matrix3d C_b_w = window.T_w_b().linear().transpose();
   const Eigen::Matrix3d P_b = C_b_w * P_ * C_b_w.transpose();
+  const BasePrior prior{P_b, C_b_w * P_tb_, P_bb_};
+  const bool with_bias = biasEnabled();
   for (int i = kChannels; i < window.size() * kChannels; ++i) {
     const int s = i / kChannels, channel = i % kChannels;
     const std::size_t ring =
@@ -190,16 +214,19 @@ Status SunWindowTerm::onSolve(backend::BundleWindow& window) {
     Pending& p = pending_[ring];
     const Eigen::Vector3d sun_b = C_b_w * p.obs.sun_w;
     bool cost_built = false;  // p.cost already holds this solve's residual
+    const bool bias_cost = with_bias && channel == 0;
+    const double* b_hat = bias_cost ? &bias_ : nullptr;
     if (!p.decided) {
-      const Eigen::Vector3d predicted_c = window.T_k_b(s).linear() * sun_b;
+      Eigen::Vector3d predicted_c = window.T_k_b(s).linear() * sun_b;
+      if (bias_cost) predicted_c = turnAboutCameraY(predicted_c, bias_);
       const double up = p.obs.sun_w.dot(options_.world_up);
       GateResult r = gateSunMeasurement(channel == 0 ? options_.gate : options_.vertical_gate,
                                         predicted_c, up, p.obs.measurement);
       if (r == GateResult::kAccepted && estimate) {
-        p.cost = makeSunCost(sun_b, p.obs.measurement, true);
+        p.cost = makeSunCost(sun_b, p.obs.measurement, true, b_hat);
         cost_built = true;
         Innovation inn;
-        const bool finite = innovation(*p.cost, window.T_k_b(s), P_b, &inn);
+        const bool finite = innovation(*p.cost, window.T_k_b(s), prior, &inn);
         if (finite) last_nis_ = inn.nis;
         if (!finite ||
             (options_.innovation_gate_chi2 > 0.0 && inn.nis > options_.innovation_gate_chi2)) {
@@ -222,17 +249,28 @@ Status SunWindowTerm::onSolve(backend::BundleWindow& window) {
     }
     if (!p.accepted || p.consumed) continue;
     // The base may have moved since the last solve (the window slid), so s_b is rebuilt each time.
-    if (!cost_built) p.cost = makeSunCost(sun_b, p.obs.measurement, estimate);
+    if (!cost_built) p.cost = makeSunCost(sun_b, p.obs.measurement, estimate, b_hat);
     if (estimate) {
-      double* extra[] = {delta_.data()};
-      SUNVO_RETURN_IF_ERROR(window.addResidual(s, p.cost.get(), loss_.get(), extra));
+      double* extra[] = {delta_.data(), &bias_delta_};
+      SUNVO_RETURN_IF_ERROR(window.addResidual(s, p.cost.get(), loss_.get(),
+                                               std::span<double* const>(extra, bias_cost ? 2 : 1)));
       p.consumed = true;
       used_in_solve_[static_cast<std::size_t>(num_used_++)] = static_cast<int>(ring);
     } else {
       SUNVO_RETURN_IF_ERROR(window.addPoseResidual(s, p.cost.get(), loss_.get()));
     }
   }
-  if (estimate && num_used_ > 0) {
+  if (estimate && num_used_ > 0 && with_bias) {
+    Eigen::Matrix4d P4 = Eigen::Matrix4d::Zero();
+    P4.topLeftCorner<3, 3>() = P_b;
+    P4.topRightCorner<3, 1>() = prior.P_tb_b;
+    P4.bottomLeftCorner<1, 3>() = prior.P_tb_b.transpose();
+    P4(3, 3) = P_bb_;
+    const Eigen::Matrix4d L = Eigen::LLT<Eigen::Matrix4d>(P4.inverse()).matrixU();
+    bias_prior_cost_.reset(AttitudeBiasPriorResidual::Create(L));
+    double* extra[] = {delta_.data(), &bias_delta_};
+    SUNVO_RETURN_IF_ERROR(window.addResidual(-1, bias_prior_cost_.get(), nullptr, extra));
+  } else if (estimate && num_used_ > 0) {
     // Square-root information of the prior: L^T L = P_b^-1.
     const Eigen::Matrix3d info = P_b.inverse();
     const Eigen::Matrix3d L = Eigen::LLT<Eigen::Matrix3d>(info).matrixU();
@@ -245,8 +283,9 @@ Status SunWindowTerm::onSolve(backend::BundleWindow& window) {
 
 void SunWindowTerm::onSolved(backend::BundleWindow& window) {
   if (!options_.estimate_base_attitude || num_used_ == 0) return;
-  // Information of the sun residuals about delta_b at the solution.
-  Eigen::Matrix3d info_b = Eigen::Matrix3d::Zero();
+  // Information of the sun residuals about (delta_b, db) at the solution (db: zero column
+  // without the bias state).
+  Eigen::Matrix4d info4 = Eigen::Matrix4d::Zero();
   for (int i = 0; i < num_used_; ++i) {
     const Pending& p =
         pending_[static_cast<std::size_t>(used_in_solve_[static_cast<std::size_t>(i)])];
@@ -256,27 +295,55 @@ void SunWindowTerm::onSolved(backend::BundleWindow& window) {
     }
     if (slot < 0 || !p.cost) continue;
     Eigen::Matrix<double, 3, 3, Eigen::RowMajor> J_d;
+    Eigen::Vector3d J_b;
     Eigen::Vector3d r;
     int m = 0;
-    if (!evaluateAt(*p.cost, window.T_k_b(slot), delta_.data(), &r, &J_d, &m)) continue;
+    if (!evaluateAt(*p.cost, window.T_k_b(slot), delta_.data(), bias_delta_, &r, &J_d, &J_b, &m)) {
+      continue;
+    }
     const RowsJacobian J = J_d.topRows(m);
-    info_b += J.transpose() * J;
+    info4.topLeftCorner<3, 3>() += J.transpose() * J;
+    if (biasEnabled()) {
+      const RowsVector jb = J_b.head(m);
+      info4.topRightCorner<3, 1>() += J.transpose() * jb;
+      info4(3, 3) += jb.squaredNorm();
+    }
   }
+  info4.bottomLeftCorner<1, 3>() = info4.topRightCorner<3, 1>().transpose();
   const Eigen::Vector3d delta_b(delta_[0], delta_[1], delta_[2]);
+  const double db = bias_delta_;
   const int used = num_used_;
   delta_ = {0.0, 0.0, 0.0};
+  bias_delta_ = 0.0;
   num_used_ = 0;
-  if (!delta_b.allFinite() || !info_b.allFinite()) return;
+  if (!delta_b.allFinite() || !info4.allFinite() || !std::isfinite(db)) return;
   const Eigen::Matrix3d C_w_b = window.T_w_b().linear();
-  const Eigen::Matrix3d A = C_w_b * info_b * C_w_b.transpose();  // information about dtheta_w
-
-  // P <- (P^-1 + A)^-1, written as P - P (I + A P)^-1 A P: no inverse of a singular A (an
-  // azimuth-only measurement informs one or two axes only).
-  const Eigen::Matrix3d M = (Eigen::Matrix3d::Identity() + A * P_).inverse() * A;
-  Eigen::Matrix3d P_new = P_ - P_ * M * P_;
-  P_new = 0.5 * (P_new + P_new.transpose());
-  if (!P_new.allFinite()) return;
-  P_ = P_new;
+  if (biasEnabled()) {
+    // The same update over (dtheta_w, b): T = diag(C_w_b, 1) takes the information to the world.
+    Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
+    T.topLeftCorner<3, 3>() = C_w_b;
+    const Eigen::Matrix4d A4 = T * info4 * T.transpose();
+    Eigen::Matrix4d P4;
+    P4 << P_, P_tb_, P_tb_.transpose(), P_bb_;
+    const Eigen::Matrix4d M4 = (Eigen::Matrix4d::Identity() + A4 * P4).inverse() * A4;
+    Eigen::Matrix4d P4_new = P4 - P4 * M4 * P4;
+    P4_new = 0.5 * (P4_new + P4_new.transpose());
+    if (!P4_new.allFinite() || !(P4_new(3, 3) >= 0.0)) return;
+    P_ = P4_new.topLeftCorner<3, 3>();
+    P_tb_ = P4_new.topRightCorner<3, 1>();
+    P_bb_ = P4_new(3, 3);
+    bias_ += db;
+  } else {
+    // information about dtheta_w
+    const Eigen::Matrix3d A = C_w_b * info4.topLeftCorner<3, 3>() * C_w_b.transpose();
+    // P <- (P^-1 + A)^-1, written as P - P (I + A P)^-1 A P: no inverse of a singular A (an
+    // azimuth-only measurement informs one or two axes only).
+    const Eigen::Matrix3d M = (Eigen::Matrix3d::Identity() + A * P_).inverse() * A;
+    Eigen::Matrix3d P_new = P_ - P_ * M * P_;
+    P_new = 0.5 * (P_new + P_new.transpose());
+    if (!P_new.allFinite()) return;
+    P_ = P_new;
+  }
   window.correctBaseAttitude(expSO3(delta_b));
   const Eigen::Vector3d c_w = C_w_b * delta_b;
   last_correction_ = {window.sequence(window.size() - 1), c_w, used};
@@ -293,6 +360,15 @@ bool SunWindowTerm::splitByGravity() const {
 }
 
 void SunWindowTerm::propagate(double frames) {
+  if (biasEnabled()) {
+    // Gauss-Markov: the estimate and its covariance with the attitude decay, the variance relaxes
+    // to sigma_b^2.
+    const double phi = std::exp(-frames / options_.sun_bias_length_frames);
+    const double sigma_b = options_.sun_bias_sigma_deg * kDeg;
+    bias_ *= phi;
+    P_tb_ *= phi;
+    P_bb_ = phi * phi * P_bb_ + (1.0 - phi * phi) * sigma_b * sigma_b;
+  }
   const double q = drift_deg_per_frame_ * kDeg;
   if (!splitByGravity() || heading_drift_deg_per_frame_ == drift_deg_per_frame_) {
     P_ += Eigen::Matrix3d::Identity() * q * q * frames;
@@ -306,15 +382,17 @@ void SunWindowTerm::propagate(double frames) {
 }
 
 bool SunWindowTerm::evaluateAt(const ceres::CostFunction& cost, const Isometry3& T_k_b,
-                               const double* delta_b, Eigen::Vector3d* r,
-                               Eigen::Matrix<double, 3, 3, Eigen::RowMajor>* J_d, int* m) {
+                               const double* delta_b, double db, Eigen::Vector3d* r,
+                               Eigen::Matrix<double, 3, 3, Eigen::RowMajor>* J_d,
+                               Eigen::Vector3d* J_bias, int* m) {
   const Eigen::Quaterniond q(T_k_b.linear());
   Eigen::Matrix<double, 3, 4, Eigen::RowMajor> J_q;
-  const double* params[] = {q.coeffs().data(), delta_b};
-  double* jacobians[] = {J_q.data(), J_d->data()};
+  J_bias->setZero();
+  const double* params[] = {q.coeffs().data(), delta_b, &db};
+  double* jacobians[] = {J_q.data(), J_d->data(), J_bias->data()};
   *m = cost.num_residuals();
   return cost.Evaluate(params, r->data(), jacobians) && r->head(*m).allFinite() &&
-         J_d->topRows(*m).allFinite();
+         J_d->topRows(*m).allFinite() && J_bias->head(*m).allFinite();
 }
 
 void SunWindowTerm::adaptDrift(const Innovation& inn, const Eigen::Matrix3d& C_w_b, int channel) {
@@ -440,17 +518,29 @@ void SunWindowTerm::inflateToEvidence() {
 }
 
 bool SunWindowTerm::innovation(const ceres::CostFunction& cost, const Isometry3& T_k_b,
-                               const Eigen::Matrix3d& P_b, Innovation* out) {
+                               const BasePrior& prior, Innovation* out) {
   const double zero[3] = {0.0, 0.0, 0.0};
   int n = 0;
-  if (!evaluateAt(cost, T_k_b, zero, &out->r, &out->J, &n) || n <= 0) return false;
+  if (!evaluateAt(cost, T_k_b, zero, 0.0, &out->r, &out->J, &out->J_bias, &n) || n <= 0) {
+    return false;
+  }
   out->dof = n;
   const RowsJacobian J = out->J.topRows(n);
-  const RowsSquare S = J * P_b * J.transpose() + RowsSquare::Identity(n, n);
+  RowsSquare S = J * prior.P_b * J.transpose() + RowsSquare::Identity(n, n);
   const RowsVector rn = out->r.head(n);
-  const RowsVector Sinv_r = S.ldlt().solve(rn);
-  out->nis = rn.dot(Sinv_r);
-  out->move_b = P_b * J.transpose() * Sinv_r;
+  if (prior.P_bb > 0.0) {
+    // S += J P_tb jb^T + jb P_tb^T J^T + P_bb jb jb^T: the bias's share of the innovation.
+    const RowsVector jb = out->J_bias.head(n);
+    const RowsVector Jp = J * prior.P_tb_b;
+    S += Jp * jb.transpose() + jb * Jp.transpose() + prior.P_bb * jb * jb.transpose();
+    const RowsVector Sinv_r = S.ldlt().solve(rn);
+    out->nis = rn.dot(Sinv_r);
+    out->move_b = (prior.P_b * J.transpose() + prior.P_tb_b * jb.transpose()) * Sinv_r;
+  } else {
+    const RowsVector Sinv_r = S.ldlt().solve(rn);
+    out->nis = rn.dot(Sinv_r);
+    out->move_b = prior.P_b * J.transpose() * Sinv_r;
+  }
   return std::isfinite(out->nis) && out->move_b.allFinite();
 }
 

@@ -55,7 +55,8 @@ int main(int argc, char** argv) {
   std::string routes_arg = "0020,00,06";
   int frames = 0, every = 5, seed = 1;
   std::optional<double> drift_deg, sun_loss, initial_sigma_deg, max_drift_deg, innovation_gate;
-  std::optional<double> evidence_sigmas, max_correction_deg;
+  std::optional<double> evidence_sigmas, evidence_correlation, max_correction_deg;
+  double sun_bias_deg = 0.0, sun_bias_length = 50.0;
   bool paper_form = false;
   bool write_poses = false;
   bool fixed_drift = false;
@@ -119,6 +120,23 @@ int main(int argc, char** argv) {
   app.add_option("--evidence-sigmas", evidence_sigmas,
                  "evidence rule: sigmas an error must reach before P covers it")
       ->check(CLI::Range(0.0, 100.0));
+  app.add_option("--evidence-correlation", evidence_correlation,
+                 "evidence rule: the sources' error correlation length, measurements")
+      ->check(CLI::Range(1.0, 1000.0));
+  app.add_option("--sun-bias-deg", sun_bias_deg,
+                 "give the estimator-like sources a correlated azimuth error of this std, deg "
+                 "(a Gauss-Markov process, docs/experiment.md)")
+      ->check(CLI::Range(0.0, 90.0));
+  app.add_option("--sun-bias-length", sun_bias_length,
+                 "its correlation length, measurements (50 = 250 frames at --every 5)")
+      ->check(CLI::Range(1.0, 1e6));
+  app.add_option("--bias-state-deg", options.fusion.sun_bias_sigma_deg,
+                 "the fusion's sun azimuth bias state: its std, deg (0 = none; the true vector "
+                 "runs without it)")
+      ->check(CLI::Range(0.0, 45.0));
+  app.add_option("--bias-state-frames", options.fusion.sun_bias_length_frames,
+                 "its correlation length, frames")
+      ->check(CLI::Range(1.0, 1e6));
   app.add_option("--max-correction-deg", max_correction_deg,
                  "refuse a measurement that would turn the attitude more, deg (0 = off)")
       ->check(CLI::Range(0.0, 180.0));
@@ -177,13 +195,19 @@ int main(int argc, char** argv) {
   }
   if (fixed_drift) options.fusion.drift_adaptation = sunvo::sunfusion::DriftAdaptation::kFixed;
   if (evidence_sigmas) options.fusion.evidence_sigmas = *evidence_sigmas;
+  if (evidence_correlation) options.fusion.evidence_correlation = *evidence_correlation;
   if (max_correction_deg) options.fusion.max_correction_deg = *max_correction_deg;
   if (innovation_gate) options.fusion.innovation_gate_chi2 = *innovation_gate;
   if (auto s = options.validate(); !s.isOk()) {
     std::fprintf(stderr, "%s: %s\n", kProgram, s.toString().c_str());
     return sunvo::cli::kExitUsage;
   }
-  const auto sources = sunvo::experiment::defaultSunSources(static_cast<std::uint32_t>(seed));
+  auto sources = sunvo::experiment::defaultSunSources(static_cast<std::uint32_t>(seed));
+  for (auto& src : sources) {
+    if (src.model.azimuth_sigma_deg == 0.0) continue;  // the true vector stays exact
+    src.model.azimuth_bias_deg = sun_bias_deg;
+    src.model.azimuth_bias_length = sun_bias_length;
+  }
   vertical_model.seed = static_cast<std::uint32_t>(seed) + 10;  // the sun sources use seed..seed+3
 
   std::string summary =
@@ -219,6 +243,8 @@ int main(int argc, char** argv) {
     for (const auto& [spec, paper, with_vertical] : plan) {
       sunvo::experiment::ExperimentOptions run_options = options;
       run_options.fusion.estimate_base_attitude = !paper;
+      // An exact source has no correlated error to model.
+      if (spec && spec->model.azimuth_sigma_deg == 0.0) run_options.fusion.sun_bias_sigma_deg = 0.0;
       if (with_vertical) run_options.vertical = vertical_model;
       auto run = sunvo::experiment::runRoute(*route, spec, run_options);
       if (!run) return sunvo::cli::fail(kProgram, route->name + ": " + run.status().toString());

@@ -81,6 +81,8 @@ Expected<ReplayRun> replayDrive(const dataset::Dataset& data, const ReplayOption
   std::optional<sunfusion::SimulatedSunSource> sun_source;
   if (spec) {
     sao.fusion.gate = spec->gate;
+    // An exact source has no correlated error to model.
+    if (spec->model.azimuth_sigma_deg == 0.0) sao.fusion.sun_bias_sigma_deg = 0.0;
     SUNVO_RETURN_IF_ERROR(spec->model.validate());
     sun_source.emplace(spec->model);
   }

@@ -8,6 +8,12 @@
 //   dropout (no measurement) -> gross outlier (uniform azimuth, zenith uniform over the upper
 //   hemisphere) -> shadow ambiguity flip (psi + 180 deg, the bimodal shadow cue) -> Gaussian
 //   azimuth and zenith errors, the zenith with a bias (Lalonde's zenith prior skews it).
+// Optionally the azimuth also carries an error that is correlated from measurement to measurement
+// (an image estimator that is wrong the same way along a whole street): a first-order
+// Gauss-Markov process b_{i+1} = phi b_i + sqrt(1 - phi^2) sigma_b n_i, phi = exp(-1 / tau), with
+// stationary std sigma_b = azimuth_bias_deg and correlation length tau = azimuth_bias_length in
+// measurements (dropped frames included). It is drawn from its own generator, so the other draws,
+// and every run without it, stay as they were.
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -28,6 +34,8 @@ struct SunErrorModel {
   double dropout_share = 0.0;       // share of frames without a measurement, [0, 1]
   bool azimuth_only = false;        // emit kAzimuthOnly measurements (Sun-CNN)
   double reported_sigma = 0.15;     // sigma written into each measurement (sets R_s), (0, 2]
+  double azimuth_bias_deg = 0.0;    // std of the correlated azimuth error, [0, 90] deg; 0 = none
+  double azimuth_bias_length = 50;  // its correlation length, [1, 1e6] measurements
   std::uint32_t seed = 1;           // RNG seed
 
   Status validate() const;
@@ -35,7 +43,10 @@ struct SunErrorModel {
 
 class SimulatedSunSource {
  public:
-  explicit SimulatedSunSource(const SunErrorModel& model) : model_(model), rng_(model.seed) {}
+  explicit SimulatedSunSource(const SunErrorModel& model)
+      : model_(model), rng_(model.seed), bias_rng_(model.seed ^ 0x5bd1e995u) {}
+  // The correlated azimuth error of the last call, rad (0 without one).
+  double azimuthBias() const { return bias_; }
 
   // A measurement for one frame from the true unit sun vector in that camera frame, or nothing
   // (dropout). Consumes random numbers in a fixed pattern, so runs are reproducible.
@@ -45,12 +56,16 @@ class SimulatedSunSource {
  private:
   SunErrorModel model_;
   std::mt19937_64 rng_;
+  std::mt19937_64 bias_rng_;
+  double bias_ = 0.0;
+  bool bias_started_ = false;
 };
 
 // An "up" source for ablations: the true up in the camera (C_c_w up_w) turned by a small random
 // rotation, each camera axis N(bias, sigma) (x: pitch, z: roll, y: about up itself, no effect), or
-// for an outlier by outlier_deg about a random axis across it, or nothing (dropout). It emulates the vertical
-// vanishing point (estimator/vertical), whose measured statistics are in docs/vertical.md.
+// for an outlier by outlier_deg about a random axis across it, or nothing (dropout). It emulates
+// the vertical vanishing point (estimator/vertical), whose measured statistics are in
+// docs/vertical.md.
 struct VerticalErrorModel {
   double sigma_deg = 1.0;           // per-axis Gaussian error, [0, 30] deg
   double pitch_bias_deg = 0.0;      // mean error about camera x, [-10, 10] deg

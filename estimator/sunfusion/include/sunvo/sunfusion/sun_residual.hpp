@@ -38,6 +38,19 @@ Eigen::Matrix<T, 3, 1> predictSun(const T* q_k_b, const T* delta, const Eigen::V
   return C_k_b * s_b;
 }
 
+// An image estimator's azimuth error that persists along a street (SunFusionOptions::
+// sun_bias_sigma_deg) is a turn of the measured sun about the camera's y axis by b: with the
+// camera azimuth psi = atan2(x, z), R_y(b) = [cos b, 0, sin b; 0, 1, 0; -sin b, 0, cos b] maps
+// azimuth psi to psi + b, so the measurement is predicted as R_y(b_hat + db) s_hat_k, with b_hat
+// the current estimate and db its correction in this solve.
+template <typename T>
+Eigen::Matrix<T, 3, 1> turnAboutCameraY(const Eigen::Matrix<T, 3, 1>& s, const T& b) {
+  using std::cos;
+  using std::sin;
+  const T c = cos(b), n = sin(b);
+  return {c * s.x() + n * s.z(), s.y(), -n * s.x() + c * s.z()};
+}
+
 // Full 3-D sun residual (the paper's Eq. 3 term).
 //
 //   residual   e_s = s_hat_k - s_k                                 (3-vector, Euclidean)
@@ -54,11 +67,16 @@ class SunDirectionResidual {
 
   template <typename T>
   bool operator()(const T* q_k_b, T* residual) const {
-    return evaluate(q_k_b, static_cast<const T*>(nullptr), residual);
+    return evaluate(q_k_b, static_cast<const T*>(nullptr), static_cast<const T*>(nullptr),
+                    residual);
   }
   template <typename T>
   bool operator()(const T* q_k_b, const T* delta, T* residual) const {
-    return evaluate(q_k_b, delta, residual);
+    return evaluate(q_k_b, delta, static_cast<const T*>(nullptr), residual);
+  }
+  template <typename T>
+  bool operator()(const T* q_k_b, const T* delta, const T* bias, T* residual) const {
+    return evaluate(q_k_b, delta, bias, residual);
   }
 
   // Blocks: q_k_b (4).
@@ -74,11 +92,20 @@ class SunDirectionResidual {
     return new ceres::AutoDiffCostFunction<SunDirectionResidual, 3, 4, 3>(
         new SunDirectionResidual(sun_b, sun_k_measured, sigma));
   }
+  // Blocks: q_k_b (4), delta (3), the azimuth bias's correction db (1); b_hat the estimate.
+  static ceres::CostFunction* CreateWithBaseCorrectionAndBias(const Eigen::Vector3d& sun_b,
+                                                              const Eigen::Vector3d& sun_k_measured,
+                                                              double sigma, double b_hat) {
+    auto* r = new SunDirectionResidual(sun_b, sun_k_measured, sigma);
+    r->b_hat_ = b_hat;
+    return new ceres::AutoDiffCostFunction<SunDirectionResidual, 3, 4, 3, 1>(r);
+  }
 
  private:
   template <typename T>
-  bool evaluate(const T* q_k_b, const T* delta, T* residual) const {
-    const Eigen::Matrix<T, 3, 1> s_hat = predictSun(q_k_b, delta, sun_b_);
+  bool evaluate(const T* q_k_b, const T* delta, const T* bias, T* residual) const {
+    Eigen::Matrix<T, 3, 1> s_hat = predictSun(q_k_b, delta, sun_b_);
+    if (bias != nullptr) s_hat = turnAboutCameraY(s_hat, T(b_hat_) + bias[0]);
     for (int i = 0; i < 3; ++i) residual[i] = (s_hat[i] - T(sun_k_[i])) * T(inv_sigma_);
     return true;
   }
@@ -86,6 +113,7 @@ class SunDirectionResidual {
   Eigen::Vector3d sun_b_;
   Eigen::Vector3d sun_k_;
   double inv_sigma_;
+  double b_hat_ = 0.0;
 };
 
 // Azimuth-only sun residual (Sun-CNN), free of elevation bias.
@@ -111,11 +139,16 @@ class SunAzimuthResidual {
 
   template <typename T>
   bool operator()(const T* q_k_b, T* residual) const {
-    return evaluate(q_k_b, static_cast<const T*>(nullptr), residual);
+    return evaluate(q_k_b, static_cast<const T*>(nullptr), static_cast<const T*>(nullptr),
+                    residual);
   }
   template <typename T>
   bool operator()(const T* q_k_b, const T* delta, T* residual) const {
-    return evaluate(q_k_b, delta, residual);
+    return evaluate(q_k_b, delta, static_cast<const T*>(nullptr), residual);
+  }
+  template <typename T>
+  bool operator()(const T* q_k_b, const T* delta, const T* bias, T* residual) const {
+    return evaluate(q_k_b, delta, bias, residual);
   }
 
   // Blocks: q_k_b (4).
@@ -131,11 +164,20 @@ class SunAzimuthResidual {
     return new ceres::AutoDiffCostFunction<SunAzimuthResidual, 2, 4, 3>(
         new SunAzimuthResidual(sun_b, azimuth_xz, sigma));
   }
+  // Blocks: q_k_b (4), delta (3), the azimuth bias's correction db (1); b_hat the estimate.
+  static ceres::CostFunction* CreateWithBaseCorrectionAndBias(const Eigen::Vector3d& sun_b,
+                                                              const Eigen::Vector2d& azimuth_xz,
+                                                              double sigma, double b_hat) {
+    auto* r = new SunAzimuthResidual(sun_b, azimuth_xz, sigma);
+    r->b_hat_ = b_hat;
+    return new ceres::AutoDiffCostFunction<SunAzimuthResidual, 2, 4, 3, 1>(r);
+  }
 
  private:
   template <typename T>
-  bool evaluate(const T* q_k_b, const T* delta, T* residual) const {
-    const Eigen::Matrix<T, 3, 1> s_hat = predictSun(q_k_b, delta, sun_b_);
+  bool evaluate(const T* q_k_b, const T* delta, const T* bias, T* residual) const {
+    Eigen::Matrix<T, 3, 1> s_hat = predictSun(q_k_b, delta, sun_b_);
+    if (bias != nullptr) s_hat = turnAboutCameraY(s_hat, T(b_hat_) + bias[0]);
     using std::sqrt;
     const T n = sqrt(s_hat.x() * s_hat.x() + s_hat.z() * s_hat.z() + T(1e-12));
     residual[0] = (s_hat.x() / n - T(m_.x())) * T(inv_sigma_);
@@ -146,6 +188,7 @@ class SunAzimuthResidual {
   Eigen::Vector3d sun_b_;
   Eigen::Vector2d m_;
   double inv_sigma_;
+  double b_hat_ = 0.0;
 };
 
 // Prior on the base-attitude correction: r = L delta with L^T L = P^-1 (square-root information
@@ -167,6 +210,28 @@ class AttitudePriorResidual {
 
  private:
   Eigen::Matrix3d L_;
+};
+
+// Joint prior on the base-attitude correction and the azimuth bias's correction:
+// r = L (delta, db) with L^T L the inverse of their 4x4 covariance.
+class AttitudeBiasPriorResidual {
+ public:
+  explicit AttitudeBiasPriorResidual(const Eigen::Matrix4d& sqrt_information)
+      : L_(sqrt_information) {}
+  template <typename T>
+  bool operator()(const T* delta, const T* bias, T* residual) const {
+    const Eigen::Matrix<T, 4, 1> x(delta[0], delta[1], delta[2], bias[0]);
+    Eigen::Map<Eigen::Matrix<T, 4, 1>> r(residual);
+    r = L_.cast<T>() * x;
+    return true;
+  }
+  static ceres::CostFunction* Create(const Eigen::Matrix4d& sqrt_information) {
+    return new ceres::AutoDiffCostFunction<AttitudeBiasPriorResidual, 4, 3, 1>(
+        new AttitudeBiasPriorResidual(sqrt_information));
+  }
+
+ private:
+  Eigen::Matrix4d L_;
 };
 
 }  // namespace sunvo::sunfusion

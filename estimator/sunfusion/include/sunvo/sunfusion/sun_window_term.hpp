@@ -62,6 +62,22 @@
 //    r^T (J P_b J^T + I)^-1 r above that bound: once the filter is confident, shadow flips and
 //    outliers that the wide cosine gate lets in are refused.
 //
+//  - Correlated sun errors (sun_bias_sigma_deg > 0): an image estimator is often wrong the same
+//    way for a whole street (measured: the real Sun-CNN on rendered drives, +2 ... +8 deg for 250
+//    frames). Its azimuth error is then modelled as a state b, a turn of the measured sun about
+//    the camera's y axis (sun_residual.hpp), with a first-order Gauss-Markov prior of stationary
+//    std sun_bias_sigma_deg and correlation length sun_bias_length_frames:
+//      b <- phi b, P_bb <- phi^2 P_bb + (1 - phi^2) sigma_b^2, P_theta_b <- phi P_theta_b,
+//      phi = exp(-frames / length).
+//    b is estimated jointly with the base correction (a 4x4 prior on (delta_b, db), the sun
+//    residuals on both, and the 4x4 information update afterwards). A rotation of the heading and
+//    a constant azimuth error look the same in one image (both turn the sun about the vertical of
+//    a level camera); they differ in time only: VO's heading error stays, b decorrelates. So the
+//    filter follows a persistent offset no further than the heading walk makes plausible against
+//    sigma_b, and it learns the heading from the average over many stretches. The innovation,
+//    the gates and the persistence test use the prediction turned by b_hat. The vertical channel
+//    has no bias state.
+//
 // A second channel of the same form: the camera's "up" measured from the images (the vertical
 // vanishing point, estimator/vertical) is a known world direction (world_up) seen in camera k,
 // exactly like the sun; addVertical() puts it through its own gate (vertical_gate) and the same
@@ -76,6 +92,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <memory>
 #include <optional>
 #include <span>
@@ -159,6 +176,11 @@ struct SunFusionOptions {
   // deg, [0, 180]; 0 = off: refuse a measurement whose predicted correction of the attitude is
   // larger (counted as rejected_correction).
   double max_correction_deg = 0.0;
+  // Correlated azimuth error of the sun channel (header comment): stationary std, deg, [0, 45];
+  // 0 = no bias state (the errors are taken as independent). Only with estimate_base_attitude.
+  double sun_bias_sigma_deg = 0.0;
+  // Its correlation length, frames, [1, 1e6] (250: a street at 10 m/s and 10 fps).
+  double sun_bias_length_frames = 250.0;
 
   Status validate() const;
   template <class Self, class V>
@@ -184,6 +206,8 @@ struct SunFusionOptions {
     v("evidence_forgetting", s.evidence_forgetting);
     v("evidence_correlation", s.evidence_correlation);
     v("max_correction_deg", s.max_correction_deg);
+    v("sun_bias_sigma_deg", s.sun_bias_sigma_deg);
+    v("sun_bias_length_frames", s.sun_bias_length_frames);
   }
 };
 
@@ -230,6 +254,9 @@ class SunWindowTerm {
   double lastInnovationNis() const { return last_nis_; }
   // Evidence rule: how often P was widened to cover an evidenced error.
   std::uint64_t numInflations() const { return num_inflations_; }
+  // The sun's azimuth bias state (sun_bias_sigma_deg > 0): estimate and std, rad (0 without it).
+  double sunAzimuthBias() const { return bias_; }
+  double sunAzimuthBiasSigma() const { return std::sqrt(std::max(P_bb_, 0.0)); }
 
  private:
   struct Pending {
@@ -243,10 +270,21 @@ class SunWindowTerm {
   void onSolved(backend::BundleWindow& window);
   // Covariance propagation over `frames` new frames.
   void propagate(double frames);
-  // Whitened residual and its Jacobian wrt delta_b of a sun cost at (C_k_b, delta_b); m rows.
+  // Whitened residual and its Jacobians wrt delta_b and (for a cost with the bias block, else
+  // zero) the bias correction db, of a sun cost at (C_k_b, delta_b, db); m rows.
   static bool evaluateAt(const ceres::CostFunction& cost, const Isometry3& T_k_b,
-                         const double* delta_b, Eigen::Vector3d* r,
-                         Eigen::Matrix<double, 3, 3, Eigen::RowMajor>* J_d, int* m);
+                         const double* delta_b, double db, Eigen::Vector3d* r,
+                         Eigen::Matrix<double, 3, 3, Eigen::RowMajor>* J_d, Eigen::Vector3d* J_bias,
+                         int* m);
+  bool biasEnabled() const {
+    return options_.sun_bias_sigma_deg > 0.0 && options_.estimate_base_attitude;
+  }
+  // The joint covariance of (delta_b, db) in the base frame (P_tb_ = 0, P_bb_ = 0 without bias).
+  struct BasePrior {
+    Eigen::Matrix3d P_b;
+    Eigen::Vector3d P_tb_b;
+    double P_bb = 0.0;
+  };
   // A measurement's innovation at delta_b = 0, from its base-correction cost: whitened residual r
   // (dof rows) and its Jacobian J wrt delta_b; nis = r^T (J P_b J^T + I)^-1 r (innovation gate).
   // False if not finite.
@@ -257,9 +295,10 @@ class SunWindowTerm {
     int dof = 0;
     double nis = 0.0;
     Eigen::Vector3d move_b = Eigen::Vector3d::Zero();  // predicted correction P_b J^T S^-1 r
+    Eigen::Vector3d J_bias = Eigen::Vector3d::Zero();  // wrt db (zero without the bias state)
   };
   static bool innovation(const ceres::CostFunction& cost, const Isometry3& T_k_b,
-                         const Eigen::Matrix3d& P_b, Innovation* out);
+                         const BasePrior& prior, Innovation* out);
   // One adaptation step of q_theta from an accepted measurement's innovation (C_w_b: base;
   // channel 0 sun, 1 vertical).
   void adaptDrift(const Innovation& inn, const Eigen::Matrix3d& C_w_b, int channel);
@@ -288,6 +327,12 @@ class SunWindowTerm {
   // Base-attitude mode state.
   std::array<double, 3> delta_{0.0, 0.0, 0.0};   // delta_b of the current solve
   Eigen::Matrix3d P_ = Eigen::Matrix3d::Zero();  // of dtheta_w, world frame, rad^2
+  // Sun azimuth bias state: estimate b (rad), its correction in the current solve, its variance
+  // and its covariance with dtheta_w (world frame).
+  double bias_ = 0.0;
+  double bias_delta_ = 0.0;
+  double P_bb_ = 0.0;
+  Eigen::Vector3d P_tb_ = Eigen::Vector3d::Zero();
   double drift_deg_per_frame_ = 0.0;          // q_theta in use (the tilt's when split), deg/frame
   double heading_drift_deg_per_frame_ = 0.0;  // the heading's q_theta when split, deg/frame
   Eigen::Vector3d persistence_g_ = Eigen::Vector3d::Zero();  // forgotten sum of H^T w r
@@ -298,6 +343,7 @@ class SunWindowTerm {
   std::array<double, 4> persistence_bound_{};  // chi-square quantile by rank 1..3
   std::optional<std::uint64_t> last_sequence_;
   std::unique_ptr<ceres::CostFunction> prior_cost_;
+  std::unique_ptr<ceres::CostFunction> bias_prior_cost_;
   std::array<int, kSlots> used_in_solve_{};  // ring indices
   int num_used_ = 0;
   Correction last_correction_;
