@@ -4,6 +4,10 @@
 
 #include <vector>
 
+#ifdef SUNVO_HAVE_ALLOC_COUNTER
+#include "sunvo/runtime/alloc_counter.hpp"
+#endif
+
 #include "../support/kitti_first_frames.hpp"
 #include "../support/synthetic_stereo.hpp"
 
@@ -96,6 +100,46 @@ TEST_F(SunAidedOdometryTest, TheSunPullsAWrongStartAttitudeBack) {
   EXPECT_LT(aided.attitudeCovariance().trace(), 0.5 * 3.0 * prior_var);
   const double about_sun = sun_w_.dot(aided.attitudeCovariance() * sun_w_);
   EXPECT_GT(about_sun, 0.9 * prior_var);
+}
+
+// Issue 19: no heap allocation per sun frame. Feature input, a sun and an "up" measurement every
+// fifth frame, with and without the bias state: after a warm-up the frames allocate nothing, the
+// sun frames included.
+TEST_F(SunAidedOdometryTest, SunFramesAllocateNothing) {
+#if !defined(SUNVO_HAVE_ALLOC_COUNTER)
+  GTEST_SKIP() << "no allocation counter in this build";
+#else
+  ASSERT_TRUE(runtime::allocCounterActive());
+  for (const double bias_deg : {0.0, 5.0}) {
+    options_.fusion.sun_bias_sigma_deg = bias_deg;
+    SunAidedOdometry odo;
+    ASSERT_TRUE(odo.init(options_, camera_, T_w_c0_, OdometryInput::kFeatures).isOk());
+    std::uint64_t sun_frames = 0, allocations = 0;
+    for (int k = 0; k < kFrames; ++k) {
+      const auto seq = static_cast<std::uint64_t>(k);
+      const Isometry3& T_w_k = T_w_k_[static_cast<std::size_t>(k)];
+      const std::uint64_t before = runtime::allocationCount();
+      if (odo.isSunFrame(seq)) {
+        sunfusion::SunObservation sun;
+        sun.measurement.sequence = seq;
+        sun.measurement.sun_c = T_w_k.linear().transpose() * sun_w_;
+        sun.measurement.sigma = 0.02;
+        sun.sun_w = sun_w_;
+        odo.addSun(sun);
+        sunfusion::SunObservation up = sun;
+        up.sun_w = options_.fusion.world_up;
+        up.measurement.sun_c = T_w_k.linear().transpose() * up.sun_w;
+        odo.addVertical(up);
+        if (k >= 20) ++sun_frames;
+      }
+      ASSERT_TRUE(odo.process(frames_[static_cast<std::size_t>(k)]));
+      if (k >= 20) allocations += runtime::allocationCount() - before;
+    }
+    EXPECT_EQ(sun_frames, 8u);
+    EXPECT_EQ(odo.sunCounters().accepted, 11u) << "bias " << bias_deg;
+    EXPECT_EQ(allocations, 0u) << "frames 20..59, bias state " << bias_deg << " deg";
+  }
+#endif
 }
 
 TEST_F(SunAidedOdometryTest, PureVoIsTheBackEndAlone) {

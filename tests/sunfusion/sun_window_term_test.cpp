@@ -10,6 +10,10 @@
 #include "sunvo/sunfusion/simulated_sun_source.hpp"
 #include "sunvo/sunfusion/sun_residual.hpp"
 
+#ifdef SUNVO_HAVE_ALLOC_COUNTER
+#include "sunvo/runtime/alloc_counter.hpp"
+#endif
+
 namespace sunvo::sunfusion {
 namespace {
 
@@ -447,6 +451,47 @@ TEST_F(SunWindowTermTest, BiasStateLeavesTheTiltToTheSun) {
   const Eigen::Vector3d e_w = logSO3(window_.T_w_b().linear());
   EXPECT_LT(std::abs(e_w.dot(across)) / kDeg, 0.1);
   EXPECT_LT(std::abs(term.sunAzimuthBias()) / kDeg, 0.1);
+}
+
+// A frame with a sun and an "up" measurement allocates nothing once the term and the window are
+// warm (issue 19: no heap allocation per sun frame): the term's costs are built by init() and only
+// get new numbers. Every form is checked: the paper's, the base correction, and the bias state.
+TEST_F(SunWindowTermTest, SunFramesAllocateNothingOnceWarm) {
+#if !defined(SUNVO_HAVE_ALLOC_COUNTER)
+  GTEST_SKIP() << "no allocation counter in this build";
+#else
+  ASSERT_TRUE(runtime::allocCounterActive());
+  SunObservation up;
+  up.sun_w = Eigen::Vector3d(0.0, -1.0, 0.0);
+  up.measurement.kind = SunMeasurementKind::kFull3d;
+  up.measurement.sigma = 1.0 * kDeg;
+  up.measurement.sun_c = T_k_b_true_.linear() * up.sun_w;
+  for (int form = 0; form < 3; ++form) {
+    SunFusionOptions opt = form == 0 ? cameraWorldOptions() : baseAttitudeOptions();
+    if (form == 2) opt.sun_bias_sigma_deg = 5.0;
+    SunWindowTerm term;
+    ASSERT_TRUE(term.init(opt).isOk());
+    const auto frame = [&](std::uint64_t k) {
+      window_.reset(T_w_b_est_);
+      term.attach(window_);
+      SunObservation sun = perfectObservation(
+          k % 4 == 1 ? SunMeasurementKind::kAzimuthOnly : SunMeasurementKind::kFull3d, 0.05);
+      sun.measurement.sequence = k;
+      term.addObservation(sun);
+      up.measurement.sequence = k;
+      term.addVertical(up);
+      const TimeNs t = static_cast<TimeNs>(k) * 100'000'000;
+      EXPECT_TRUE(window_.addFrame(k - 1, t - 100'000'000, obs_b_, Isometry3::Identity()).isOk());
+      EXPECT_TRUE(window_.addFrame(k, t, obs_k_, T_k_b_true_).isOk());
+      EXPECT_TRUE(window_.solve());
+    };
+    for (std::uint64_t k = 1; k <= 9; k += 2) frame(k);  // warm-up
+    const std::uint64_t before = runtime::allocationCount();
+    for (std::uint64_t k = 11; k <= 49; k += 2) frame(k);
+    EXPECT_EQ(runtime::allocationCount() - before, 0u) << "form " << form;
+    EXPECT_EQ(term.counters().accepted + term.verticalCounters().accepted, 50u) << "form " << form;
+  }
+#endif
 }
 
 TEST_F(SunWindowTermTest, EvidenceRuleIgnoresZeroMeanNoiseAndOutliers) {

@@ -27,31 +27,6 @@ double chiSquareCdf(double x, int dof) {
   return e - std::sqrt(2.0 * x / M_PI) * std::exp(-0.5 * x);
 }
 
-// The sun residual of a measurement against the sun in the base frame: 3-D or azimuth-only, on
-// C_k_b alone (the paper's form) or also on the base correction delta_b, and with b_hat also on
-// the azimuth bias's correction (b_hat: the bias estimate, or null).
-std::unique_ptr<ceres::CostFunction> makeSunCost(const Eigen::Vector3d& sun_b,
-                                                 const SunMeasurement& m, bool base_correction,
-                                                 const double* b_hat = nullptr) {
-  if (m.kind == SunMeasurementKind::kAzimuthOnly) {
-    const Eigen::Vector2d xz = xzDirection(m.sun_c);
-    if (b_hat != nullptr) {
-      return std::unique_ptr<ceres::CostFunction>(
-          SunAzimuthResidual::CreateWithBaseCorrectionAndBias(sun_b, xz, m.sigma, *b_hat));
-    }
-    return std::unique_ptr<ceres::CostFunction>(
-        base_correction ? SunAzimuthResidual::CreateWithBaseCorrection(sun_b, xz, m.sigma)
-                        : SunAzimuthResidual::Create(sun_b, xz, m.sigma));
-  }
-  if (b_hat != nullptr) {
-    return std::unique_ptr<ceres::CostFunction>(
-        SunDirectionResidual::CreateWithBaseCorrectionAndBias(sun_b, m.sun_c, m.sigma, *b_hat));
-  }
-  return std::unique_ptr<ceres::CostFunction>(
-      base_correction ? SunDirectionResidual::CreateWithBaseCorrection(sun_b, m.sun_c, m.sigma)
-                      : SunDirectionResidual::Create(sun_b, m.sun_c, m.sigma));
-}
-
 // x with chiSquareCdf(x, dof) = p, by bisection (p in (0, 1)).
 double chiSquareQuantile(double p, int dof) {
   double lo = 0.0, hi = 200.0;
@@ -163,7 +138,38 @@ Status SunWindowTerm::init(const SunFusionOptions& options) {
   num_corrections_ = 0;
   last_nis_ = 0.0;
   num_inflations_ = 0;
+  // Every cost a slot can need, in the form the options ask for (the only allocations).
+  const SunResidualForm form = !options.estimate_base_attitude ? SunResidualForm::kPaper
+                               : biasEnabled() ? SunResidualForm::kBaseCorrectionAndBias
+                                               : SunResidualForm::kBaseCorrection;
+  for (std::size_t i = 0; i < kSlots; ++i) {
+    // The vertical channel (odd slots) has no bias state.
+    const SunResidualForm f = form == SunResidualForm::kBaseCorrectionAndBias && i % kChannels != 0
+                                  ? SunResidualForm::kBaseCorrection
+                                  : form;
+    CostSlot& c = costs_[i];
+    c.direction = new SunDirectionResidual(Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitZ(), 1.0);
+    c.direction_cost.reset(wrapSunResidual<SunDirectionResidual, 3>(c.direction, f));
+    c.azimuth = new SunAzimuthResidual(Eigen::Vector3d::UnitZ(), Eigen::Vector2d::UnitY(), 1.0);
+    c.azimuth_cost.reset(wrapSunResidual<SunAzimuthResidual, 2>(c.azimuth, f));
+  }
+  prior_ = new AttitudePriorResidual(Eigen::Matrix3d::Identity());
+  prior_cost_.reset(new ceres::AutoDiffCostFunction<AttitudePriorResidual, 3, 3>(prior_));
+  bias_prior_ = new AttitudeBiasPriorResidual(Eigen::Matrix4d::Identity());
+  bias_prior_cost_.reset(
+      new ceres::AutoDiffCostFunction<AttitudeBiasPriorResidual, 4, 3, 1>(bias_prior_));
   return Status::ok();
+}
+
+ceres::CostFunction* SunWindowTerm::setSunCost(std::size_t ring, const Eigen::Vector3d& sun_b,
+                                               const SunMeasurement& m) {
+  CostSlot& c = costs_[ring];
+  if (m.kind == SunMeasurementKind::kAzimuthOnly) {
+    c.azimuth->set(sun_b, xzDirection(m.sun_c), m.sigma, bias_);
+    return c.azimuth_cost.get();
+  }
+  c.direction->set(sun_b, m.sun_c, m.sigma, bias_);
+  return c.direction_cost.get();
 }
 
 void SunWindowTerm::attach(backend::BundleWindow& window) {
@@ -215,7 +221,6 @@ Status SunWindowTerm::onSolve(backend::BundleWindow& window) {
     const Eigen::Vector3d sun_b = C_b_w * p.obs.sun_w;
     bool cost_built = false;  // p.cost already holds this solve's residual
     const bool bias_cost = with_bias && channel == 0;
-    const double* b_hat = bias_cost ? &bias_ : nullptr;
     if (!p.decided) {
       Eigen::Vector3d predicted_c = window.T_k_b(s).linear() * sun_b;
       if (bias_cost) predicted_c = turnAboutCameraY(predicted_c, bias_);
@@ -223,7 +228,7 @@ Status SunWindowTerm::onSolve(backend::BundleWindow& window) {
       GateResult r = gateSunMeasurement(channel == 0 ? options_.gate : options_.vertical_gate,
                                         predicted_c, up, p.obs.measurement);
       if (r == GateResult::kAccepted && estimate) {
-        p.cost = makeSunCost(sun_b, p.obs.measurement, true, b_hat);
+        p.cost = setSunCost(ring, sun_b, p.obs.measurement);
         cost_built = true;
         Innovation inn;
         const bool finite = innovation(*p.cost, window.T_k_b(s), prior, &inn);
@@ -249,15 +254,15 @@ Status SunWindowTerm::onSolve(backend::BundleWindow& window) {
     }
     if (!p.accepted || p.consumed) continue;
     // The base may have moved since the last solve (the window slid), so s_b is rebuilt each time.
-    if (!cost_built) p.cost = makeSunCost(sun_b, p.obs.measurement, estimate, b_hat);
+    if (!cost_built) p.cost = setSunCost(ring, sun_b, p.obs.measurement);
     if (estimate) {
       double* extra[] = {delta_.data(), &bias_delta_};
-      SUNVO_RETURN_IF_ERROR(window.addResidual(s, p.cost.get(), loss_.get(),
+      SUNVO_RETURN_IF_ERROR(window.addResidual(s, p.cost, loss_.get(),
                                                std::span<double* const>(extra, bias_cost ? 2 : 1)));
       p.consumed = true;
       used_in_solve_[static_cast<std::size_t>(num_used_++)] = static_cast<int>(ring);
     } else {
-      SUNVO_RETURN_IF_ERROR(window.addPoseResidual(s, p.cost.get(), loss_.get()));
+      SUNVO_RETURN_IF_ERROR(window.addPoseResidual(s, p.cost, loss_.get()));
     }
   }
   if (estimate && num_used_ > 0 && with_bias) {
@@ -266,15 +271,14 @@ Status SunWindowTerm::onSolve(backend::BundleWindow& window) {
     P4.topRightCorner<3, 1>() = prior.P_tb_b;
     P4.bottomLeftCorner<1, 3>() = prior.P_tb_b.transpose();
     P4(3, 3) = P_bb_;
-    const Eigen::Matrix4d L = Eigen::LLT<Eigen::Matrix4d>(P4.inverse()).matrixU();
-    bias_prior_cost_.reset(AttitudeBiasPriorResidual::Create(L));
+    bias_prior_->set(Eigen::LLT<Eigen::Matrix4d>(P4.inverse()).matrixU());
     double* extra[] = {delta_.data(), &bias_delta_};
     SUNVO_RETURN_IF_ERROR(window.addResidual(-1, bias_prior_cost_.get(), nullptr, extra));
   } else if (estimate && num_used_ > 0) {
     // Square-root information of the prior: L^T L = P_b^-1.
     const Eigen::Matrix3d info = P_b.inverse();
     const Eigen::Matrix3d L = Eigen::LLT<Eigen::Matrix3d>(info).matrixU();
-    prior_cost_.reset(AttitudePriorResidual::Create(L));
+    prior_->set(L);
     double* extra[] = {delta_.data()};
     SUNVO_RETURN_IF_ERROR(window.addResidual(-1, prior_cost_.get(), nullptr, extra));
   }

@@ -51,6 +51,26 @@ Eigen::Matrix<T, 3, 1> turnAboutCameraY(const Eigen::Matrix<T, 3, 1>& s, const T
   return {c * s.x() + n * s.z(), s.y(), -n * s.x() + c * s.z()};
 }
 
+// Which blocks a sun residual acts on, after q_k_b (4): none (the paper's form), the base
+// correction delta (3), or delta and the azimuth bias's correction db (1).
+enum class SunResidualForm { kPaper, kBaseCorrection, kBaseCorrectionAndBias };
+
+// The cost function of a sun residual functor in a form; takes ownership of r. The caller may
+// keep r and change its numbers with set() between solves (the window term reuses its costs so
+// that a measurement allocates nothing).
+template <class Residual, int kRows>
+ceres::CostFunction* wrapSunResidual(Residual* r, SunResidualForm form) {
+  switch (form) {
+    case SunResidualForm::kPaper:
+      return new ceres::AutoDiffCostFunction<Residual, kRows, 4>(r);
+    case SunResidualForm::kBaseCorrection:
+      return new ceres::AutoDiffCostFunction<Residual, kRows, 4, 3>(r);
+    case SunResidualForm::kBaseCorrectionAndBias:
+      break;
+  }
+  return new ceres::AutoDiffCostFunction<Residual, kRows, 4, 3, 1>(r);
+}
+
 // Full 3-D sun residual (the paper's Eq. 3 term).
 //
 //   residual   e_s = s_hat_k - s_k                                 (3-vector, Euclidean)
@@ -62,8 +82,17 @@ Eigen::Matrix<T, 3, 1> turnAboutCameraY(const Eigen::Matrix<T, 3, 1>& s, const T
 class SunDirectionResidual {
  public:
   SunDirectionResidual(const Eigen::Vector3d& sun_b, const Eigen::Vector3d& sun_k_measured,
-                       double sigma)
-      : sun_b_(sun_b), sun_k_(sun_k_measured), inv_sigma_(1.0 / sigma) {}
+                       double sigma, double b_hat = 0.0) {
+    set(sun_b, sun_k_measured, sigma, b_hat);
+  }
+  // New numbers for the same residual (b_hat: the bias estimate, used in the bias form only).
+  void set(const Eigen::Vector3d& sun_b, const Eigen::Vector3d& sun_k_measured, double sigma,
+           double b_hat = 0.0) {
+    sun_b_ = sun_b;
+    sun_k_ = sun_k_measured;
+    inv_sigma_ = 1.0 / sigma;
+    b_hat_ = b_hat;
+  }
 
   template <typename T>
   bool operator()(const T* q_k_b, T* residual) const {
@@ -82,23 +111,15 @@ class SunDirectionResidual {
   // Blocks: q_k_b (4).
   static ceres::CostFunction* Create(const Eigen::Vector3d& sun_b,
                                      const Eigen::Vector3d& sun_k_measured, double sigma) {
-    return new ceres::AutoDiffCostFunction<SunDirectionResidual, 3, 4>(
-        new SunDirectionResidual(sun_b, sun_k_measured, sigma));
+    return wrapSunResidual<SunDirectionResidual, 3>(
+        new SunDirectionResidual(sun_b, sun_k_measured, sigma), SunResidualForm::kPaper);
   }
   // Blocks: q_k_b (4), delta (3).
   static ceres::CostFunction* CreateWithBaseCorrection(const Eigen::Vector3d& sun_b,
                                                        const Eigen::Vector3d& sun_k_measured,
                                                        double sigma) {
-    return new ceres::AutoDiffCostFunction<SunDirectionResidual, 3, 4, 3>(
-        new SunDirectionResidual(sun_b, sun_k_measured, sigma));
-  }
-  // Blocks: q_k_b (4), delta (3), the azimuth bias's correction db (1); b_hat the estimate.
-  static ceres::CostFunction* CreateWithBaseCorrectionAndBias(const Eigen::Vector3d& sun_b,
-                                                              const Eigen::Vector3d& sun_k_measured,
-                                                              double sigma, double b_hat) {
-    auto* r = new SunDirectionResidual(sun_b, sun_k_measured, sigma);
-    r->b_hat_ = b_hat;
-    return new ceres::AutoDiffCostFunction<SunDirectionResidual, 3, 4, 3, 1>(r);
+    return wrapSunResidual<SunDirectionResidual, 3>(
+        new SunDirectionResidual(sun_b, sun_k_measured, sigma), SunResidualForm::kBaseCorrection);
   }
 
  private:
@@ -112,7 +133,7 @@ class SunDirectionResidual {
 
   Eigen::Vector3d sun_b_;
   Eigen::Vector3d sun_k_;
-  double inv_sigma_;
+  double inv_sigma_ = 1.0;
   double b_hat_ = 0.0;
 };
 
@@ -134,8 +155,17 @@ class SunDirectionResidual {
 // (s_hat_x = s_hat_z = 0); the norm is floored there and the gate rejects such measurements.
 class SunAzimuthResidual {
  public:
-  SunAzimuthResidual(const Eigen::Vector3d& sun_b, const Eigen::Vector2d& azimuth_xz, double sigma)
-      : sun_b_(sun_b), m_(azimuth_xz.normalized()), inv_sigma_(1.0 / sigma) {}
+  SunAzimuthResidual(const Eigen::Vector3d& sun_b, const Eigen::Vector2d& azimuth_xz, double sigma,
+                     double b_hat = 0.0) {
+    set(sun_b, azimuth_xz, sigma, b_hat);
+  }
+  void set(const Eigen::Vector3d& sun_b, const Eigen::Vector2d& azimuth_xz, double sigma,
+           double b_hat = 0.0) {
+    sun_b_ = sun_b;
+    m_ = azimuth_xz.normalized();
+    inv_sigma_ = 1.0 / sigma;
+    b_hat_ = b_hat;
+  }
 
   template <typename T>
   bool operator()(const T* q_k_b, T* residual) const {
@@ -154,23 +184,15 @@ class SunAzimuthResidual {
   // Blocks: q_k_b (4).
   static ceres::CostFunction* Create(const Eigen::Vector3d& sun_b,
                                      const Eigen::Vector2d& azimuth_xz, double sigma) {
-    return new ceres::AutoDiffCostFunction<SunAzimuthResidual, 2, 4>(
-        new SunAzimuthResidual(sun_b, azimuth_xz, sigma));
+    return wrapSunResidual<SunAzimuthResidual, 2>(new SunAzimuthResidual(sun_b, azimuth_xz, sigma),
+                                                  SunResidualForm::kPaper);
   }
   // Blocks: q_k_b (4), delta (3).
   static ceres::CostFunction* CreateWithBaseCorrection(const Eigen::Vector3d& sun_b,
                                                        const Eigen::Vector2d& azimuth_xz,
                                                        double sigma) {
-    return new ceres::AutoDiffCostFunction<SunAzimuthResidual, 2, 4, 3>(
-        new SunAzimuthResidual(sun_b, azimuth_xz, sigma));
-  }
-  // Blocks: q_k_b (4), delta (3), the azimuth bias's correction db (1); b_hat the estimate.
-  static ceres::CostFunction* CreateWithBaseCorrectionAndBias(const Eigen::Vector3d& sun_b,
-                                                              const Eigen::Vector2d& azimuth_xz,
-                                                              double sigma, double b_hat) {
-    auto* r = new SunAzimuthResidual(sun_b, azimuth_xz, sigma);
-    r->b_hat_ = b_hat;
-    return new ceres::AutoDiffCostFunction<SunAzimuthResidual, 2, 4, 3, 1>(r);
+    return wrapSunResidual<SunAzimuthResidual, 2>(new SunAzimuthResidual(sun_b, azimuth_xz, sigma),
+                                                  SunResidualForm::kBaseCorrection);
   }
 
  private:
@@ -187,7 +209,7 @@ class SunAzimuthResidual {
 
   Eigen::Vector3d sun_b_;
   Eigen::Vector2d m_;
-  double inv_sigma_;
+  double inv_sigma_ = 1.0;
   double b_hat_ = 0.0;
 };
 
@@ -196,6 +218,7 @@ class SunAzimuthResidual {
 class AttitudePriorResidual {
  public:
   explicit AttitudePriorResidual(const Eigen::Matrix3d& sqrt_information) : L_(sqrt_information) {}
+  void set(const Eigen::Matrix3d& sqrt_information) { L_ = sqrt_information; }
   template <typename T>
   bool operator()(const T* delta, T* residual) const {
     const Eigen::Map<const Eigen::Matrix<T, 3, 1>> d(delta);
@@ -218,6 +241,7 @@ class AttitudeBiasPriorResidual {
  public:
   explicit AttitudeBiasPriorResidual(const Eigen::Matrix4d& sqrt_information)
       : L_(sqrt_information) {}
+  void set(const Eigen::Matrix4d& sqrt_information) { L_ = sqrt_information; }
   template <typename T>
   bool operator()(const T* delta, const T* bias, T* residual) const {
     const Eigen::Matrix<T, 4, 1> x(delta[0], delta[1], delta[2], bias[0]);

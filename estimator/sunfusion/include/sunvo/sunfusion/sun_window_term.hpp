@@ -85,8 +85,9 @@
 // (verticalCounters()). One sun direction leaves the rotation about the sun axis free; "up"
 // fixes roll and pitch, so the two together observe the whole attitude.
 //
-// Nothing here allocates per frame except the cost functions of an accepted measurement (every
-// fifth frame by default), which live until the next solve.
+// Nothing here allocates per frame: init() builds every cost function a slot of the window can
+// need (3-D and azimuth-only sun, in the form the options ask for, and the priors), and a
+// measurement only writes its numbers into them.
 
 #include <ceres/loss_function.h>
 
@@ -101,6 +102,7 @@
 #include "sunvo/backend/bundle_window.hpp"
 #include "sunvo/sunfusion/sun_gate.hpp"
 #include "sunvo/sunfusion/sun_measurement.hpp"
+#include "sunvo/sunfusion/sun_residual.hpp"
 
 namespace sunvo::sunfusion {
 
@@ -263,9 +265,20 @@ class SunWindowTerm {
     SunObservation obs;
     bool decided = false;
     bool accepted = false;
-    bool consumed = false;  // used in a base-attitude solve already
-    std::unique_ptr<ceres::CostFunction> cost;
+    bool consumed = false;                // used in a base-attitude solve already
+    ceres::CostFunction* cost = nullptr;  // one of costs_[ring], set for this measurement
   };
+  // The pre-built sun costs of one ring slot; each functor is owned by its cost function.
+  struct CostSlot {
+    SunDirectionResidual* direction = nullptr;
+    SunAzimuthResidual* azimuth = nullptr;
+    std::unique_ptr<ceres::CostFunction> direction_cost;
+    std::unique_ptr<ceres::CostFunction> azimuth_cost;
+  };
+  // The slot's cost for a measurement, its numbers set (s_b: the sun in the base frame; the bias
+  // form takes the current bias estimate).
+  ceres::CostFunction* setSunCost(std::size_t ring, const Eigen::Vector3d& sun_b,
+                                  const SunMeasurement& m);
   Status onSolve(backend::BundleWindow& window);
   void onSolved(backend::BundleWindow& window);
   // Covariance propagation over `frames` new frames.
@@ -320,6 +333,7 @@ class SunWindowTerm {
   static constexpr std::size_t kSlots = backend::BundleWindow::kMaxWindowSize * kChannels;
   void add(const SunObservation& observation, int channel);
   std::array<Pending, kSlots> pending_;
+  std::array<CostSlot, kSlots> costs_;
   std::array<bool, kSlots> used_{};
   GateCounters counters_;
   GateCounters vertical_counters_;
@@ -342,7 +356,9 @@ class SunWindowTerm {
   double persistence_T_ = 0.0;
   std::array<double, 4> persistence_bound_{};  // chi-square quantile by rank 1..3
   std::optional<std::uint64_t> last_sequence_;
+  AttitudePriorResidual* prior_ = nullptr;  // owned by prior_cost_
   std::unique_ptr<ceres::CostFunction> prior_cost_;
+  AttitudeBiasPriorResidual* bias_prior_ = nullptr;  // owned by bias_prior_cost_
   std::unique_ptr<ceres::CostFunction> bias_prior_cost_;
   std::array<int, kSlots> used_in_solve_{};  // ring indices
   int num_used_ = 0;
