@@ -130,13 +130,7 @@ int main(int argc, char** argv) {
   app.add_option("--sun-bias-length", sun_bias_length,
                  "its correlation length, measurements (50 = 250 frames at --every 5)")
       ->check(CLI::Range(1.0, 1e6));
-  app.add_option("--bias-state-deg", options.fusion.sun_bias_sigma_deg,
-                 "the fusion's sun azimuth bias state: its std, deg (0 = none; the true vector "
-                 "runs without it)")
-      ->check(CLI::Range(0.0, 45.0));
-  app.add_option("--bias-state-frames", options.fusion.sun_bias_length_frames,
-                 "its correlation length, frames")
-      ->check(CLI::Range(1.0, 1e6));
+  sunvo::cli::addBiasStateOptions(app, options.fusion);
   app.add_option("--max-correction-deg", max_correction_deg,
                  "refuse a measurement that would turn the attitude more, deg (0 = off)")
       ->check(CLI::Range(0.0, 180.0));

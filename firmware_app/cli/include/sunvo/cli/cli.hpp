@@ -59,4 +59,17 @@ void addRotationRatePriorOptions(CLI::App& app, WindowOptions& win) {
       ->check(CLI::Range(1e-3, 180.0));
 }
 
+// The fusion's sun azimuth bias state (sunfusion::SunFusionOptions, docs/experiment.md), the same
+// in every program that runs the fusion: --bias-state-deg, --bias-state-frames.
+template <class FusionOptions>
+void addBiasStateOptions(CLI::App& app, FusionOptions& fusion) {
+  app.add_option("--bias-state-deg", fusion.sun_bias_sigma_deg,
+                 "the fusion's sun azimuth bias state: its std, deg (0 = none; the true vector "
+                 "runs without it)")
+      ->check(CLI::Range(0.0, 45.0));
+  app.add_option("--bias-state-frames", fusion.sun_bias_length_frames,
+                 "its correlation length, frames")
+      ->check(CLI::Range(1.0, 1e6));
+}
+
 }  // namespace sunvo::cli
