@@ -1,7 +1,6 @@
-// Raw stereo calibrations (drivers/calib): the OpenCV stereo reader (yaml-cpp; XML through
-// cv::FileStorage) and the Kalibr camchain reader (yaml-cpp) on the same input. Neither may throw
-// or crash; a file either reader accepts must be finite and give a usable rectified camera or a
-// refusal.
+// Raw stereo calibrations (drivers/calib): the OpenCV stereo reader and the Kalibr camchain
+// reader (both yaml-cpp) on the same input. Neither may throw or crash; a file either reader
+// accepts must be finite and give a usable rectified camera or a refusal.
 #include <cmath>
 #include <filesystem>
 

@@ -5,7 +5,6 @@
 #include <cmath>
 #include <fstream>
 #include <initializer_list>
-#include <optional>
 #include <sstream>
 #include <string_view>
 #include <utility>
@@ -49,10 +48,13 @@ cv::Matx33d toMatx33(const std::vector<double>& v) {
 }
 
 // --- OpenCV stereo files --------------------------------------------------------------------
+// Read with yaml-cpp, never with cv::FileStorage: fuzzing found OpenCV 4.6's YAML parser looping
+// forever six times (bytes >= 0x80, an indented first key, a stream of "---" markers) and its XML
+// parser dereferencing a null pointer (docs/hardening.md). A guard per shape never closes such a
+// family, so no calibration text reaches those parsers. YAML and JSON are read; XML is refused.
 
 // Offset of the first byte that is not printable ASCII, tab, CR or LF, or npos. Calibration files
-// are ASCII; OpenCV 4.6's parsers loop forever on bytes >= 0x80 (found twice by fuzzing), so
-// only ASCII reaches them.
+// are ASCII.
 std::size_t firstNonText(const std::string& s) {
   for (std::size_t i = 0; i < s.size(); ++i) {
     const auto c = static_cast<unsigned char>(s[i]);
@@ -61,162 +63,60 @@ std::size_t firstNonText(const std::string& s) {
   return std::string::npos;
 }
 
-// The top-level keys of an OpenCV stereo file, whichever parser read it. YAML and JSON go to
-// yaml-cpp; only XML goes to cv::FileStorage. OpenCV 4.6's YAML parser loops forever on inputs
-// a fuzzer finds within a minute (an indented first key, a stream of "---" markers; see
-// docs/hardening.md), and a guard per shape never closes that family.
-class Fields {
- public:
-  virtual ~Fields() = default;
-  virtual bool has(const char* key) const = 0;
-  // The numbers under key, row-major: an !!opencv-matrix, a (nested) list or one number. False
-  // if the node holds anything else.
-  virtual bool numbers(const char* key, std::vector<double>* out) const = 0;
-  // A scalar's text, or nothing if the node is not a string.
-  virtual std::optional<std::string> text(const char* key) const = 0;
-  // An integer, or nothing if the node is not one.
-  virtual std::optional<int> integer(const char* key) const = 0;
-};
+// A matrix is checked before its data is read: rows and cols in [1, 64] (a calibration matrix or
+// distortion vector is far smaller; a damaged header once made OpenCV ask for 48 GB) and data of
+// rows x cols numbers.
+constexpr int kMaxMatrixSide = 64;
 
-// An !!opencv-matrix header is checked before its data is read: OpenCV sizes the matrix from
-// rows and cols as they stand, and a damaged header made it ask for 48 GB (found by fuzzing).
-constexpr int kMaxMatrixSide = 64;  // a calibration matrix or distortion vector is far smaller
-
-bool matrixShapeOk(int rows, int cols, std::size_t data_size) {
-  return rows >= 1 && rows <= kMaxMatrixSide && cols >= 1 && cols <= kMaxMatrixSide &&
-         data_size == static_cast<std::size_t>(rows) * static_cast<std::size_t>(cols);
+bool asNumber(const YAML::Node& n, double* v) {
+  return n.IsScalar() && YAML::convert<double>::decode(n, *v);
 }
 
-class YamlFields final : public Fields {
- public:
-  explicit YamlFields(YAML::Node root) : root_(std::move(root)) {}
+bool asInteger(const YAML::Node& n, int* v) {
+  return n && n.IsScalar() && YAML::convert<int>::decode(n, *v);
+}
 
-  bool has(const char* key) const override { return static_cast<bool>(root_[key]); }
-
-  bool numbers(const char* key, std::vector<double>* out) const override {
-    const YAML::Node n = root_[key];
-    return n && numbersOf(n, 0, out);
-  }
-
-  std::optional<std::string> text(const char* key) const override {
-    const YAML::Node n = root_[key];
-    if (!n || !n.IsScalar()) return std::nullopt;
-    return n.Scalar();
-  }
-
-  std::optional<int> integer(const char* key) const override {
-    const YAML::Node n = root_[key];
-    int v = 0;
-    if (!n || !n.IsScalar() || !YAML::convert<int>::decode(n, v)) return std::nullopt;
-    return v;
-  }
-
- private:
-  static bool number(const YAML::Node& n, std::vector<double>* out) {
-    double v = 0.0;
-    if (!n.IsScalar() || !YAML::convert<double>::decode(n, v)) return false;
-    out->push_back(v);
+// The numbers of a node, row-major: an !!opencv-matrix map (rows, cols, dt, data), a list (nested
+// at most two deep: [[fx, 0, cx], ...]) or one number. False if the node holds anything else.
+bool numbersOf(const YAML::Node& n, int depth, std::vector<double>* out) {
+  if (n.IsMap()) {
+    int r = 0, c = 0;
+    const YAML::Node data = n["data"];
+    if (!asInteger(n["rows"], &r) || !asInteger(n["cols"], &c) || !data || !data.IsSequence() ||
+        r < 1 || r > kMaxMatrixSide || c < 1 || c > kMaxMatrixSide ||
+        data.size() != static_cast<std::size_t>(r) * static_cast<std::size_t>(c)) {
+      return false;
+    }
+    // OpenCV's one-channel element types; a matrix of another type is not a calibration.
+    if (const YAML::Node dt = n["dt"];
+        dt && !(dt.IsScalar() && dt.Scalar().size() == 1 &&
+                std::string_view("ucwsifd").find(dt.Scalar()[0]) != std::string_view::npos)) {
+      return false;
+    }
+    for (const YAML::Node& e : data) {
+      double v = 0.0;
+      if (!asNumber(e, &v)) return false;
+      out->push_back(v);
+    }
     return true;
   }
-
-  // depth: calibration lists nest two deep at most ([[fx, 0, cx], ...]).
-  static bool numbersOf(const YAML::Node& n, int depth, std::vector<double>* out) {
-    if (n.IsMap()) {
-      const YAML::Node rows = n["rows"];
-      const YAML::Node cols = n["cols"];
-      const YAML::Node data = n["data"];
-      const YAML::Node dt = n["dt"];
-      int r = 0, c = 0;
-      if (!rows || !cols || !data || !rows.IsScalar() || !cols.IsScalar() || !data.IsSequence() ||
-          !YAML::convert<int>::decode(rows, r) || !YAML::convert<int>::decode(cols, c) ||
-          !matrixShapeOk(r, c, data.size())) {
-        return false;
-      }
-      // OpenCV's one-channel element types; a matrix of another type is not a calibration.
-      if (dt && !(dt.IsScalar() && dt.Scalar().size() == 1 &&
-                  std::string_view("ucwsifd").find(dt.Scalar()[0]) != std::string_view::npos)) {
-        return false;
-      }
-      for (const YAML::Node& e : data) {
-        if (!number(e, out)) return false;
-      }
-      return true;
+  if (n.IsSequence()) {
+    if (depth >= 2) return false;
+    for (const YAML::Node& e : n) {
+      if (!numbersOf(e, depth + 1, out)) return false;
     }
-    if (n.IsSequence()) {
-      if (depth >= 2) return false;
-      for (const YAML::Node& e : n) {
-        if (!numbersOf(e, depth + 1, out)) return false;
-      }
-      return true;
-    }
-    return number(n, out);
+    return true;
   }
+  double v = 0.0;
+  if (!asNumber(n, &v)) return false;
+  out->push_back(v);
+  return true;
+}
 
-  YAML::Node root_;
-};
-
-// OpenCV XML, through cv::FileStorage (which may throw cv::Exception).
-class CvFields final : public Fields {
- public:
-  explicit CvFields(const cv::FileStorage& fs) : fs_(fs) {}
-
-  bool has(const char* key) const override { return !fs_[key].empty(); }
-
-  bool numbers(const char* key, std::vector<double>* out) const override {
-    return numbersOf(fs_[key], out);
-  }
-
-  std::optional<std::string> text(const char* key) const override {
-    const cv::FileNode n = fs_[key];
-    if (!n.isString()) return std::nullopt;
-    return n.string();
-  }
-
-  std::optional<int> integer(const char* key) const override {
-    const cv::FileNode n = fs_[key];
-    if (!n.isInt()) return std::nullopt;
-    return static_cast<int>(n);
-  }
-
- private:
-  static bool numbersOf(const cv::FileNode& n, std::vector<double>* out) {
-    if (n.isMap()) {
-      const cv::FileNode rows = n["rows"];
-      const cv::FileNode cols = n["cols"];
-      const cv::FileNode data = n["data"];
-      if (!rows.isInt() || !cols.isInt() || !data.isSeq() ||
-          !matrixShapeOk(static_cast<int>(rows), static_cast<int>(cols), data.size())) {
-        return false;
-      }
-      cv::Mat m;
-      cv::read(n, m);
-      if (m.empty()) return false;
-      cv::Mat d;
-      m.convertTo(d, CV_64F);
-      d = d.reshape(1, 1);
-      out->insert(out->end(), d.begin<double>(), d.end<double>());
-      return true;
-    }
-    if (n.isSeq()) {
-      for (const cv::FileNode& e : n) {
-        if (!numbersOf(e, out)) return false;
-      }
-      return true;
-    }
-    if (n.isInt() || n.isReal()) {
-      out->push_back(static_cast<double>(n));
-      return true;
-    }
-    return false;
-  }
-
-  const cv::FileStorage& fs_;
-};
-
-// The first of `names` present; empty if none.
-std::string firstKey(const Fields& f, std::initializer_list<const char*> names) {
+// The first of `names` present in root; empty if none.
+std::string firstKey(const YAML::Node& root, std::initializer_list<const char*> names) {
   for (const char* n : names) {
-    if (f.has(n)) return n;
+    if (root[n]) return n;
   }
   return {};
 }
@@ -228,13 +128,13 @@ std::string spellings(std::initializer_list<const char*> names) {
 }
 
 // Reads one of `names` with one of `counts` numbers.
-Status readNumbers(const Fields& f, const std::string& path,
+Status readNumbers(const YAML::Node& root, const std::string& path,
                    std::initializer_list<const char*> names, std::initializer_list<int> counts,
                    std::vector<double>* out) {
-  const std::string key = firstKey(f, names);
+  const std::string key = firstKey(root, names);
   if (key.empty()) return keyError(path, spellings(names), "missing");
   out->clear();
-  if (!f.numbers(key.c_str(), out)) return keyError(path, key, "expected numbers");
+  if (!numbersOf(root[key], 0, out)) return keyError(path, key, "expected numbers");
   bool count_ok = false;
   for (const int c : counts) count_ok = count_ok || static_cast<int>(out->size()) == c;
   if (!count_ok) {
@@ -246,21 +146,21 @@ Status readNumbers(const Fields& f, const std::string& path,
   return Status::ok();
 }
 
-Status readImageSize(const Fields& f, const std::string& path, cv::Size* size) {
+Status readImageSize(const YAML::Node& root, const std::string& path, cv::Size* size) {
   for (const auto& [w, h] :
        {std::pair<const char*, const char*>{"image_width", "image_height"}, {"width", "height"}}) {
-    if (!f.has(w) && !f.has(h)) continue;
-    const std::optional<int> width = f.integer(w);
-    if (!width) return keyError(path, w, "expected an integer");
-    const std::optional<int> height = f.integer(h);
-    if (!height) return keyError(path, h, "expected an integer");
-    *size = cv::Size(*width, *height);
+    if (!root[w] && !root[h]) continue;
+    int width = 0, height = 0;
+    if (!asInteger(root[w], &width)) return keyError(path, w, "expected an integer");
+    if (!asInteger(root[h], &height)) return keyError(path, h, "expected an integer");
+    *size = cv::Size(width, height);
     return Status::ok();
   }
   std::vector<double> wh;
   const Status s = readNumbers(
-      f, path, {"image_size", "imageSize", "size", "image_width + image_height", "width + height"},
-      {2}, &wh);
+      root, path,
+      {"image_size", "imageSize", "size", "image_width + image_height", "width + height"}, {2},
+      &wh);
   if (!s.isOk()) return s;
   *size = cv::Size(static_cast<int>(std::lround(wh[0])), static_cast<int>(std::lround(wh[1])));
   return Status::ok();
@@ -284,31 +184,30 @@ cv::Mat rowOf(const std::vector<double>& v) {
   return cv::Mat(1, static_cast<int>(v.size()), CV_64F, const_cast<double*>(v.data())).clone();
 }
 
-// Every key of an OpenCV stereo file into c (may throw cv::Exception or YAML::Exception).
-Status readOpenCvFields(const Fields& f, const std::string& path, RawStereoCalibration* c) {
+// Every key of an OpenCV stereo file into c (may throw YAML::Exception).
+Status readOpenCvFields(const YAML::Node& root, const std::string& path, RawStereoCalibration* c) {
   std::vector<double> v;
   SUNVO_RETURN_IF_ERROR(
-      readNumbers(f, path, {"K1", "M1", "cameraMatrix1", "camera_matrix_left"}, {9}, &v));
+      readNumbers(root, path, {"K1", "M1", "cameraMatrix1", "camera_matrix_left"}, {9}, &v));
   c->K_left = toMatx33(v);
   SUNVO_RETURN_IF_ERROR(
-      readNumbers(f, path, {"K2", "M2", "cameraMatrix2", "camera_matrix_right"}, {9}, &v));
+      readNumbers(root, path, {"K2", "M2", "cameraMatrix2", "camera_matrix_right"}, {9}, &v));
   c->K_right = toMatx33(v);
-  if (f.has("distortion_model")) {
-    const std::optional<std::string> m = f.text("distortion_model");
-    if (!m) return keyError(path, "distortion_model", "expected a name");
-    SUNVO_RETURN_IF_ERROR(readModel(path, "distortion_model", *m, &c->model));
+  if (const YAML::Node m = root["distortion_model"]; m) {
+    if (!m.IsScalar()) return keyError(path, "distortion_model", "expected a name");
+    SUNVO_RETURN_IF_ERROR(readModel(path, "distortion_model", m.Scalar(), &c->model));
   }
   SUNVO_RETURN_IF_ERROR(
-      readNumbers(f, path, {"D1", "distCoeffs1", "dist_coeffs_left"}, {4, 5, 8, 12, 14}, &v));
+      readNumbers(root, path, {"D1", "distCoeffs1", "dist_coeffs_left"}, {4, 5, 8, 12, 14}, &v));
   c->D_left = rowOf(v);
   SUNVO_RETURN_IF_ERROR(
-      readNumbers(f, path, {"D2", "distCoeffs2", "dist_coeffs_right"}, {4, 5, 8, 12, 14}, &v));
+      readNumbers(root, path, {"D2", "distCoeffs2", "dist_coeffs_right"}, {4, 5, 8, 12, 14}, &v));
   c->D_right = rowOf(v);
-  SUNVO_RETURN_IF_ERROR(readNumbers(f, path, {"R"}, {9}, &v));
+  SUNVO_RETURN_IF_ERROR(readNumbers(root, path, {"R"}, {9}, &v));
   c->C_r_l = toMatx33(v);
-  SUNVO_RETURN_IF_ERROR(readNumbers(f, path, {"T"}, {3}, &v));
+  SUNVO_RETURN_IF_ERROR(readNumbers(root, path, {"T"}, {3}, &v));
   c->t_r_l = cv::Vec3d(v[0], v[1], v[2]);
-  return readImageSize(f, path, &c->size);
+  return readImageSize(root, path, &c->size);
 }
 
 // --- Kalibr (yaml-cpp) -------------------------------------------------------------------------
@@ -443,35 +342,29 @@ Expected<RawStereoCalibration> readOpenCvStereo(const std::string& path) {
                       " is not ASCII text (OpenCV calibration files are ASCII)");
   }
   const std::size_t first = text.find_first_not_of(" \t\r\n");
+  if (first != std::string::npos && text.compare(first, 5, "<?xml") == 0) {
+    return parseError(fileName(path) +
+                      ": an OpenCV XML file; write the calibration as YAML or JSON (the same keys; "
+                      "cv::FileStorage writes YAML for a .yaml name)");
+  }
+  // OpenCV writes "%YAML:1.0", which is not a YAML directive; it becomes a comment, so line
+  // numbers stay those of the file. A file without it is read the same way.
+  if (first != std::string::npos && text.compare(first, 6, "%YAML:") == 0) text[first] = '#';
   try {
-    if (first != std::string::npos && text.compare(first, 5, "<?xml") == 0) {
-      cv::FileStorage fs;
-      if (!fs.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY)) {
-        return parseError(fileName(path) + ": not a readable OpenCV XML file");
-      }
-      SUNVO_RETURN_IF_ERROR(readOpenCvFields(CvFields(fs), path, &c));
-    } else {
-      // OpenCV writes "%YAML:1.0", which is not a YAML directive; it becomes a comment, so
-      // line numbers stay those of the file. A file without it is read the same way.
-      if (first != std::string::npos && text.compare(first, 6, "%YAML:") == 0) text[first] = '#';
-      YAML::Node root;
-      try {
-        root = YAML::Load(text);
-      } catch (const YAML::Exception& e) {
-        return parseError(fileName(path) + ": line " + std::to_string(e.mark.line + 1) +
-                          ": not a readable OpenCV YAML file: " + e.msg);
-      }
-      if (!root.IsMap()) {
-        return parseError(fileName(path) + ": not an OpenCV stereo file (no map of keys)");
-      }
-      SUNVO_RETURN_IF_ERROR(readOpenCvFields(YamlFields(root), path, &c));
+    YAML::Node root;
+    try {
+      root = YAML::Load(text);
+    } catch (const YAML::Exception& e) {
+      return parseError(fileName(path) + ": line " + std::to_string(e.mark.line + 1) +
+                        ": not a readable OpenCV YAML file: " + e.msg);
     }
-  } catch (const cv::Exception& e) {
-    return parseError(fileName(path) + ": not a readable OpenCV file: " + e.msg);
+    if (!root.IsMap()) {
+      return parseError(fileName(path) + ": not an OpenCV stereo file (no map of keys)");
+    }
+    SUNVO_RETURN_IF_ERROR(readOpenCvFields(root, path, &c));
   } catch (const std::exception& e) {
-    // FileStorage also lets standard exceptions out (std::length_error on a damaged matrix
-    // header; found by fuzzing); YAML::Exception derives from std::runtime_error.
-    return parseError(fileName(path) + ": not a readable OpenCV file: " + e.what());
+    // yaml-cpp's exceptions derive from std::runtime_error.
+    return parseError(fileName(path) + ": not a readable OpenCV YAML file: " + e.what());
   }
   const Status s = c.validate();
   if (!s.isOk()) return s;

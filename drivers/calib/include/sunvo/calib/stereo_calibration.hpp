@@ -2,10 +2,10 @@
 // The raw (unrectified) calibration of a stereo rig, read from the files that calibration tools
 // write. Two formats:
 //
-// OpenCV stereo YAML, JSON or XML as cv::FileStorage writes them (the layout of OpenCV's
-// stereo_calib sample and of most scripts around cv::stereoCalibrate; a YAML file without the
-// "%YAML" line is read too). YAML and JSON are parsed with yaml-cpp, XML with cv::FileStorage:
-// OpenCV 4.6's own YAML parser can loop forever on damaged input (docs/hardening.md).
+// OpenCV stereo YAML or JSON as cv::FileStorage writes them (the layout of OpenCV's stereo_calib
+// sample and of most scripts around cv::stereoCalibrate; a YAML file without the "%YAML" line is
+// read too), parsed with yaml-cpp: OpenCV 4.6's own parsers loop forever or crash on damaged
+// input (docs/hardening.md). An XML file is refused with a hint to write YAML.
 // Matrices as !!opencv-matrix or as flat lists of numbers, row-major. Accepted keys
 // (the first spelling present wins):
 //   left intrinsics   K1 | M1 | cameraMatrix1 | camera_matrix_left      3x3
