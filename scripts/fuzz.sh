@@ -16,7 +16,8 @@ elif [[ "${1:-}" =~ ^[0-9]+$ ]]; then
   limit=(-max_total_time="$1")
   shift
 fi
-all=(kitti_calibration kitti_timestamps oxts poses tracks sun_csv mavlink rover_yaml stereo_calibration)
+all=(kitti_calibration kitti_timestamps oxts poses tracks sun_csv mavlink rover_yaml stereo_calibration
+  sun_cnn_options)
 harnesses=("$@")
 [[ ${#harnesses[@]} -eq 0 ]] && harnesses=("${all[@]}")
 cmake --preset fuzz >/dev/null

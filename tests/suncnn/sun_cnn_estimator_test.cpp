@@ -347,6 +347,23 @@ TEST(SunCnnEstimator, RejectsWrongInput) {
   ASSERT_FALSE(range.hasValue());
   EXPECT_NE(range.status().message().find("suncnn.input_channels"), std::string::npos);
   EXPECT_FALSE(loadSunCnnOptions(dir + "/none.json").hasValue());
+  // Found by fuzzing (fuzz_sun_cnn_options, 2026-11-26): a section that is not an object made
+  // cv::FileNode::operator[] throw out of the reader (std::terminate). Now each of these is an
+  // error naming the file and the key, as is a value that does not fit its integer field.
+  for (const auto& [text, key] :
+       {std::pair<const char*, const char*>{"{ \"input\": \"sun_cnn.onnx\" }", "'input'"},
+        {"{ \"mc\": [1, 2] }", "'mc'"},
+        {"{ \"input\": { \"width\": 1e300 } }", "'input.width'"},
+        {"{ \"mc\": { \"rows\": 2.5 } }", "'mc.rows'"},
+        {"{ \"sigma_scale\": .nan }", "'sigma_scale'"},
+        {"{ \"input\": { \"width\": 208", "line 1"},
+        {"[1, 2]", "not a JSON object"}}) {
+    std::ofstream(dir + "/fuzzed.json") << text;
+    auto f = loadSunCnnOptions(dir + "/fuzzed.json");
+    ASSERT_FALSE(f.hasValue()) << text;
+    EXPECT_NE(f.status().message().find("fuzzed.json"), std::string::npos) << text;
+    EXPECT_NE(f.status().message().find(key), std::string::npos) << f.status().message();
+  }
 
   // The model from bytes behaves as the model from the file.
   std::ifstream mf(kModel, std::ios::binary);

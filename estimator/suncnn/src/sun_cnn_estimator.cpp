@@ -83,11 +83,11 @@ Status SunCnnEstimator::finishInit() {
   small1_.create(o.input_height, o.input_width, CV_8UC1);
   const int blob_shape[] = {1, o.input_channels, o.input_height, o.input_width};
   blob_.create(4, blob_shape, CV_32F);
-  blob_.setTo(0.0f);
+  blob_.setTo(cv::Scalar(0.0));
   mask1_.create(o.mask_rows, o.mask1_size, CV_32F);
   mask2_.create(o.mask_rows, o.mask2_size, CV_32F);
-  mask1_.setTo(1.0f);
-  mask2_.setTo(1.0f);
+  mask1_.setTo(cv::Scalar(1.0));
+  mask2_.setTo(cv::Scalar(1.0));
   // One forward pass checks the model against the shapes the options promise.
   try {
     net_.setInput(blob_, "image");
@@ -115,7 +115,7 @@ void SunCnnEstimator::fillMasks() {
   const float keep = static_cast<float>(1.0 / (1.0 - options_.dropout_p));
   std::bernoulli_distribution dropped(options_.dropout_p);
   for (cv::Mat* m : {&mask1_, &mask2_}) {
-    m->row(0).setTo(1.0f);
+    m->row(0).setTo(cv::Scalar(1.0));
     for (int r = 1; r <= options_.mc_samples; ++r) {
       float* p = m->ptr<float>(r);
       for (int j = 0; j < m->cols; ++j) p[j] = dropped(rng_) ? 0.0f : keep;

@@ -1,5 +1,11 @@
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
 #include <filesystem>
-#include <opencv2/core/persistence.hpp>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <type_traits>
 
 #include "sunvo/suncnn/sun_cnn_estimator.hpp"
 
@@ -11,38 +17,71 @@ std::string modelJsonPath(const std::string& model_path) {
   return p.string();
 }
 
+// The JSON is read with yaml-cpp (JSON is YAML), not cv::FileStorage: fuzzing found OpenCV's
+// parsers looping and crashing on damaged calibration files (docs/hardening.md), and
+// FileNode::operator[] threw out of this reader on a section that was not an object
+// (tests/fuzz: sun_cnn_options).
 Expected<SunCnnOptions> loadSunCnnOptions(const std::string& json_path, const SunCnnOptions& base) {
-  cv::FileStorage fs;
-  try {
-    if (!fs.open(json_path, cv::FileStorage::READ | cv::FileStorage::FORMAT_JSON))
-      return notFound("suncnn: cannot open the model's JSON " + json_path);
-  } catch (const cv::Exception& e) {
-    return parseError("suncnn: " + json_path + ": not valid JSON: " + e.msg);
-  }
-  SunCnnOptions o = base;
-  // Reads one number; a missing key keeps the default, a non-number is an error naming it.
+  std::ifstream in(json_path, std::ios::binary);
+  if (!in) return notFound("suncnn: cannot open the model's JSON " + json_path);
+  std::ostringstream text;
+  text << in.rdbuf();
   Status st;
-  auto num = [&](const cv::FileNode& parent, const char* key, const std::string& name, auto& out) {
-    if (!st.isOk()) return;
-    const cv::FileNode n = parent[key];
-    if (n.empty() || n.isNone()) return;
-    if (!n.isReal() && !n.isInt()) {
-      st = parseError("suncnn: " + json_path + ": key '" + name + "' is not a number");
-      return;
+  SunCnnOptions o = base;
+  try {
+    YAML::Node parsed;
+    try {
+      parsed = YAML::Load(text.str());
+    } catch (const YAML::Exception& e) {
+      return parseError("suncnn: " + json_path + ": line " + std::to_string(e.mark.line + 1) +
+                        ": not valid JSON: " + e.msg);
     }
-    out = static_cast<std::remove_reference_t<decltype(out)>>(static_cast<double>(n));
-  };
-  const cv::FileNode root = fs.root(), in = root["input"], mc = root["mc"];
-  num(in, "width", "input.width", o.input_width);
-  num(in, "height", "input.height", o.input_height);
-  num(in, "channels", "input.channels", o.input_channels);
-  num(mc, "members", "mc.members", o.ensemble_members);
-  num(mc, "rows", "mc.rows", o.mask_rows);
-  num(mc, "mask1", "mc.mask1", o.mask1_size);
-  num(mc, "mask2", "mc.mask2", o.mask2_size);
-  num(mc, "dropout_p", "mc.dropout_p", o.dropout_p);
-  num(root, "sigma_scale", "sigma_scale", o.sigma_scale);
-  num(root, "max_valid_sigma_rad", "max_valid_sigma_rad", o.max_valid_sigma_rad);
+    const YAML::Node& root = parsed;  // const: a lookup never inserts a key
+    if (!root.IsMap()) return parseError("suncnn: " + json_path + ": not a JSON object");
+    // A section that is absent keeps every default; one that is not an object is an error.
+    const auto section = [&](const char* key) {
+      const YAML::Node n = root[key];
+      if (n && !n.IsNull() && !n.IsMap() && st.isOk()) {
+        st = parseError("suncnn: " + json_path + ": key '" + key + "' is not an object");
+      }
+      return n && n.IsMap() ? n : YAML::Node(YAML::NodeType::Map);
+    };
+    // One number; a missing key keeps the default. A non-number, a non-finite number or, for an
+    // integer field, a fraction or an out-of-range value is an error naming the key.
+    const auto num = [&](const YAML::Node& parent, const char* key, const std::string& name,
+                         auto& out) {
+      using T = std::remove_reference_t<decltype(out)>;
+      if (!st.isOk()) return;
+      const YAML::Node n = parent[key];
+      if (!n || n.IsNull()) return;
+      double v = 0.0;
+      if (!n.IsScalar() || !YAML::convert<double>::decode(n, v) || !std::isfinite(v)) {
+        st = parseError("suncnn: " + json_path + ": key '" + name + "' is not a number");
+        return;
+      }
+      if constexpr (std::is_integral_v<T>) {
+        if (v != std::floor(v) || v < static_cast<double>(std::numeric_limits<T>::min()) ||
+            v > static_cast<double>(std::numeric_limits<T>::max())) {
+          st = parseError("suncnn: " + json_path + ": key '" + name + "' is not an integer");
+          return;
+        }
+      }
+      out = static_cast<T>(v);
+    };
+    const YAML::Node in_node = section("input"), mc = section("mc");
+    num(in_node, "width", "input.width", o.input_width);
+    num(in_node, "height", "input.height", o.input_height);
+    num(in_node, "channels", "input.channels", o.input_channels);
+    num(mc, "members", "mc.members", o.ensemble_members);
+    num(mc, "rows", "mc.rows", o.mask_rows);
+    num(mc, "mask1", "mc.mask1", o.mask1_size);
+    num(mc, "mask2", "mc.mask2", o.mask2_size);
+    num(mc, "dropout_p", "mc.dropout_p", o.dropout_p);
+    num(root, "sigma_scale", "sigma_scale", o.sigma_scale);
+    num(root, "max_valid_sigma_rad", "max_valid_sigma_rad", o.max_valid_sigma_rad);
+  } catch (const YAML::Exception& e) {
+    return parseError("suncnn: " + json_path + ": " + e.what());
+  }
   SUNVO_RETURN_IF_ERROR(st);
   if (auto v = o.validate(); !v.isOk()) return invalidArgument(json_path + ": " + v.message());
   return o;
