@@ -48,10 +48,12 @@ cv::Matx33d toMatx33(const std::vector<double>& v) {
 }
 
 // --- OpenCV stereo files --------------------------------------------------------------------
-// Read with yaml-cpp, never with cv::FileStorage: fuzzing found OpenCV 4.6's YAML parser looping
-// forever six times (bytes >= 0x80, an indented first key, a stream of "---" markers) and its XML
-// parser dereferencing a null pointer (docs/hardening.md). A guard per shape never closes such a
-// family, so no calibration text reaches those parsers. YAML and JSON are read; XML is refused.
+// Read with yaml-cpp, never with cv::FileStorage: fuzzing found OpenCV 4.6's YAML reading fail
+// six ways (four endless loops: 0xFF bytes, a UTF-8 character, an indented first key, a stream
+// of "---" markers; a damaged matrix header asking for 48 GB; an escaped std::length_error) and
+// its XML parser dereferencing a null pointer (docs/hardening.md). A guard per shape never closes
+// such a family, so no calibration text reaches those parsers. YAML and JSON are read; XML is
+// refused.
 
 // Offset of the first byte that is not printable ASCII, tab, CR or LF, or npos. Calibration files
 // are ASCII.
