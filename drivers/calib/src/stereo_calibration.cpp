@@ -70,8 +70,12 @@ std::size_t firstNonText(const std::string& s) {
 // rows x cols numbers.
 constexpr int kMaxMatrixSide = 64;
 
-bool asNumber(const YAML::Node& n, double* v) {
-  return n.IsScalar() && YAML::convert<double>::decode(n, *v);
+// Appends the number a scalar node holds; false (nothing appended) for anything else.
+bool appendNumber(const YAML::Node& n, std::vector<double>* out) {
+  double v = 0.0;
+  if (!n.IsScalar() || !YAML::convert<double>::decode(n, v)) return false;
+  out->push_back(v);
+  return true;
 }
 
 bool asInteger(const YAML::Node& n, int* v) {
@@ -96,9 +100,7 @@ bool numbersOf(const YAML::Node& n, int depth, std::vector<double>* out) {
       return false;
     }
     for (const YAML::Node& e : data) {
-      double v = 0.0;
-      if (!asNumber(e, &v)) return false;
-      out->push_back(v);
+      if (!appendNumber(e, out)) return false;
     }
     return true;
   }
@@ -109,10 +111,7 @@ bool numbersOf(const YAML::Node& n, int depth, std::vector<double>* out) {
     }
     return true;
   }
-  double v = 0.0;
-  if (!asNumber(n, &v)) return false;
-  out->push_back(v);
-  return true;
+  return appendNumber(n, out);
 }
 
 // The first of `names` present in root; empty if none.
@@ -224,21 +223,13 @@ Status kalibrNumbers(const YAML::Node& cam, const std::string& path, const std::
   const YAML::Node n = cam[key];
   if (!n) return keyError(path, full, "missing");
   out->clear();
-  const auto take = [&](const YAML::Node& x) {
-    try {
-      out->push_back(x.as<double>());
-      return true;
-    } catch (const YAML::Exception&) {
-      return false;
-    }
-  };
   bool ok = n.IsSequence();
   for (std::size_t i = 0; ok && i < n.size(); ++i) {
     const YAML::Node e = n[i];
     if (e.IsSequence()) {
-      for (std::size_t j = 0; ok && j < e.size(); ++j) ok = e[j].IsScalar() && take(e[j]);
+      for (std::size_t j = 0; ok && j < e.size(); ++j) ok = appendNumber(e[j], out);
     } else {
-      ok = e.IsScalar() && take(e);
+      ok = appendNumber(e, out);
     }
   }
   const std::string where = fileName(path) + ":" + line(n) + ": " + full;

@@ -266,11 +266,8 @@ Status SunWindowTerm::onSolve(backend::BundleWindow& window) {
     }
   }
   if (estimate && num_used_ > 0 && with_bias) {
-    Eigen::Matrix4d P4 = Eigen::Matrix4d::Zero();
-    P4.topLeftCorner<3, 3>() = P_b;
-    P4.topRightCorner<3, 1>() = prior.P_tb_b;
-    P4.bottomLeftCorner<1, 3>() = prior.P_tb_b.transpose();
-    P4(3, 3) = P_bb_;
+    Eigen::Matrix4d P4;
+    P4 << P_b, prior.P_tb_b, prior.P_tb_b.transpose(), P_bb_;
     bias_prior_->set(Eigen::LLT<Eigen::Matrix4d>(P4.inverse()).matrixU());
     double* extra[] = {delta_.data(), &bias_delta_};
     SUNVO_RETURN_IF_ERROR(window.addResidual(-1, bias_prior_cost_.get(), nullptr, extra));
