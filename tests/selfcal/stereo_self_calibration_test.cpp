@@ -67,6 +67,40 @@ TEST(StereoSelfCalibration, RecoversAnInjectedRightCameraRotation) {
   EXPECT_LT(r.roll_sigma_mrad, 0.01 * kDeg * 1e3);
 }
 
+// A rig that warms up turns its right camera as a ramp. The drift rate follows it; the random walk
+// alone trails it by rate / gain.
+TEST(StereoSelfCalibration, FollowsARampingRigWithItsDriftRate) {
+  const auto clean = tracks(200, 0.3);
+  constexpr int kFrames = 150;
+  const double roll_rate = 6e-4 * kDeg;  // rad per frame: 0.09 deg over the frames used
+  const double pitch_rate = -2e-4 * kDeg;
+  auto frames = clean;
+  for (int k = 0; k < kFrames; ++k) {
+    std::vector<FrameFeatures> one{frames[static_cast<std::size_t>(k)]};
+    miscalibrate(one, 0.02 * kDeg + pitch_rate * k, 0.01 * kDeg + roll_rate * k);
+    frames[static_cast<std::size_t>(k)] = one[0];
+  }
+  auto lag = [&](double rate_sigma_deg, SelfCalibrationReport* last) {
+    StereoSelfCalibrationOptions o = on();
+    o.drift_rate_sigma_deg = rate_sigma_deg;
+    StereoSelfCalibration cal;
+    EXPECT_TRUE(cal.init(o, camera()).isOk());
+    FrameFeatures out;
+    for (int k = 0; k < kFrames; ++k)
+      *last = cal.process(frames[static_cast<std::size_t>(k)], &out);
+    return std::abs(last->roll_mrad * 1e-3 - (0.01 * kDeg + roll_rate * (kFrames - 1))) / kDeg;
+  };
+  SelfCalibrationReport with_rate, without;
+  const double lag_rate = lag(5e-4, &with_rate);
+  const double lag_walk = lag(0.0, &without);
+  EXPECT_LT(lag_rate, 0.005);  // deg
+  EXPECT_GT(lag_walk, 0.01);   // deg: the random walk of 1e-4 deg/frame alone trails the ramp
+  EXPECT_NEAR(with_rate.roll_rate_urad * 1e-6, roll_rate, 0.25 * roll_rate);
+  EXPECT_NEAR(with_rate.pitch_mrad * 1e-3, 0.02 * kDeg + pitch_rate * (kFrames - 1), 0.005 * kDeg);
+  EXPECT_EQ(without.roll_rate_urad, 0.0);
+  EXPECT_EQ(with_rate.resets, 0u);
+}
+
 // Observations whose right row was not measured (v_right_measured = false: the image front end
 // found no row information in the window) carry no information and are not used, whatever their
 // v_right says.
@@ -160,8 +194,12 @@ TEST(StereoSelfCalibration, ReportCsvRowMatchesItsHeader) {
   r.roll_sigma_mrad = 0.01437;
   r.used = 207;
   r.reset = true;
-  EXPECT_STREQ(kReportCsvHeader, "frame,pitch_mrad,roll_mrad,scale,roll_sigma_mrad,used,reset\n");
-  EXPECT_EQ(reportCsvRow(42, r), "42,-0.15112,-0.78821,0.0006171,0.01437,207,1\n");
+  r.pitch_rate_urad = 0.0123;
+  r.roll_rate_urad = -5.8171;
+  EXPECT_STREQ(kReportCsvHeader,
+               "frame,pitch_mrad,roll_mrad,scale,roll_sigma_mrad,used,reset,pitch_rate_urad,"
+               "roll_rate_urad\n");
+  EXPECT_EQ(reportCsvRow(42, r), "42,-0.15112,-0.78821,0.0006171,0.01437,207,1,0.0123,-5.8171\n");
 }
 
 }  // namespace

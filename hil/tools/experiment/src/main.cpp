@@ -112,6 +112,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.0, 1.0));
   app.add_flag("--self-calib", self_calib,
                "online stereo self-calibration of the right camera before the odometry");
+  sunvo::cli::addSelfCalibrationRateOptions(app, options.self_calibration);
   app.add_option("--drift-rule", drift_rule, "how the random walk adapts")
       ->check(CLI::IsMember({"persistence", "median", "fixed", "evidence"}));
   app.add_flag("!--no-split-drift", options.fusion.split_drift_by_gravity,

@@ -72,4 +72,18 @@ void addBiasStateOptions(CLI::App& app, FusionOptions& fusion) {
       ->check(CLI::Range(1.0, 1e6));
 }
 
+// The stereo self-calibration's drift rate (selfcal::StereoSelfCalibrationOptions,
+// docs/backend.md), the same in every program that runs it: --self-calib-rate-deg,
+// --self-calib-rate-frames.
+template <class SelfCalibrationOptions>
+void addSelfCalibrationRateOptions(CLI::App& app, SelfCalibrationOptions& sc) {
+  app.add_option("--self-calib-rate-deg", sc.drift_rate_sigma_deg,
+                 "std of the self-calibration's pitch/roll drift rate, deg/frame (0 = random walk "
+                 "only)")
+      ->check(CLI::Range(0.0, 0.1));
+  app.add_option("--self-calib-rate-frames", sc.drift_rate_time_frames,
+                 "correlation time of that drift rate, frames")
+      ->check(CLI::Range(1.0, 1e7));
+}
+
 }  // namespace sunvo::cli
