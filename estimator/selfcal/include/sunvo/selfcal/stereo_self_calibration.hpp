@@ -134,7 +134,6 @@ class StereoSelfCalibration {
   Mat5 F_ = Mat5::Identity();  // the prediction (see the header)
   Mat5 Q_ = Mat5::Zero();
   double max_rate_ = 0.0;  // rad/frame: 10 stationary stds
-
   std::uint64_t resets_ = 0;
 };
 
