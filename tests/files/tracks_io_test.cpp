@@ -221,5 +221,47 @@ TEST(TracksIo, ReadsTheReal0020Folder) {
   EXPECT_EQ(missing.status().code(), StatusCode::kNotFound);
 }
 
+// writeTrackFolder and readTrackFolder are inverses (to the 1e-4 px the csv keeps).
+TEST(TracksIo, AWrittenFolderReadsBack) {
+  sunvo::testing::TempDir dir;
+  const StereoCamera camera{721.5377, 721.5377, 609.5593, 172.854, 0.537, 1242, 375};
+  std::vector<FrameFeatures> frames(3);
+  std::vector<Isometry3> gt(3, Isometry3::Identity());
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    frames[k].time_ns = 1789035300000000000 + static_cast<TimeNs>(k) * 100000000 + 7;
+    frames[k].sequence = 40 + k;  // the folder counts its own frames from 0
+    gt[k].translation() = Eigen::Vector3d(0.1 * static_cast<double>(k), 0.0, 1.0 * k);
+    for (int i = 0; i < 4; ++i) {
+      StereoObservation o;
+      o.landmark_id = static_cast<std::int64_t>(k) + i;
+      o.u_left = 100.25 + 10 * i;
+      o.v_left = 50.5 + i;
+      o.u_right = o.u_left - 12.3456;
+      o.v_right = o.v_left + 0.0625;
+      frames[k].observations.push_back(o);
+    }
+  }
+  frames[1].observations[2].landmark_id = -1;  // no landmark: not written
+  ASSERT_TRUE(writeTrackFolder(dir.str(), camera, frames, gt).isOk());
+  auto seq = readTrackFolder(dir.str(), TrackReadOptions{});
+  ASSERT_TRUE(seq) << seq.status().toString();
+  EXPECT_EQ(seq->image_size_source, "calib.txt");
+  EXPECT_EQ(seq->camera.width, 1242);
+  EXPECT_DOUBLE_EQ(seq->camera.fu, 721.5377);
+  ASSERT_EQ(seq->frames.size(), 3u);
+  ASSERT_EQ(seq->gt_T_0_k.size(), 3u);
+  EXPECT_NEAR((seq->gt_T_0_k[2].translation() - gt[2].translation()).norm(), 0.0, 1e-12);
+  EXPECT_EQ(seq->frames[2].time_ns, frames[2].time_ns);  // exact to the nanosecond
+  EXPECT_EQ(seq->frames[1].observations.size(), 3u);
+  const StereoObservation& o = seq->frames[2].observations[3];
+  EXPECT_EQ(o.landmark_id, 5);
+  EXPECT_NEAR(o.u_right, frames[2].observations[3].u_right, 1e-4);
+  EXPECT_NEAR(o.v_right, frames[2].observations[3].v_right, 1e-4);
+  // A pose list of the wrong length is refused before anything is written.
+  gt.pop_back();
+  EXPECT_EQ(writeTrackFolder(dir.str(), camera, frames, gt).message(),
+            "writeTrackFolder: 2 ground-truth poses for 3 frames");
+}
+
 }  // namespace
 }  // namespace sunvo::files

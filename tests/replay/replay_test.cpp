@@ -38,10 +38,14 @@ TEST(Replay, RenderedDriveThroughTheWholeChain) {
   ASSERT_EQ(data->groundTruth().size(), 20u);
   const std::vector<Isometry3>& gt = data->groundTruth();
 
+  options.record_features = true;  // what sunvo_replay --write-tracks writes
   auto pure = replayDrive(*data, options, std::nullopt);
+  options.record_features = false;
   ASSERT_TRUE(pure) << pure.status().toString();
   ASSERT_EQ(pure->T_w_c.size(), 20u);
   EXPECT_EQ(pure->lost_frames, 0);
+  ASSERT_EQ(pure->features.size(), 20u);
+  EXPECT_GT(pure->features.back().observations.size(), 100u);
   metrics::EvaluationOptions eval;
   eval.plane = metrics::HorizontalPlane::kEastNorth;
   auto ev = metrics::evaluate(gt, pure->T_w_c, eval);

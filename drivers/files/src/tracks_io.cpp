@@ -279,4 +279,39 @@ Expected<TrackSequence> readTrackFolder(const std::string& folder,
   return seq;
 }
 
+Status writeTrackFolder(const std::string& folder, const StereoCamera& camera,
+                        const std::vector<FrameFeatures>& frames,
+                        const std::vector<Isometry3>& gt_T_0_k) {
+  if (!gt_T_0_k.empty() && gt_T_0_k.size() != frames.size()) {
+    return invalidArgument("writeTrackFolder: " + std::to_string(gt_T_0_k.size()) +
+                           " ground-truth poses for " + std::to_string(frames.size()) + " frames");
+  }
+  char line[256];
+  std::snprintf(line, sizeof(line), "%.10g %.10g %.10g %.10g %.10g %d %d\n", camera.fu, camera.fv,
+                camera.cu, camera.cv, camera.baseline_m, camera.width, camera.height);
+  SUNVO_RETURN_IF_ERROR(writeWholeFile(folder + "/calib.txt", line));
+  std::string times, tracks = "frame,landmark,uL,vL,uR,vR\n";
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    // Whole seconds and nanoseconds apart: exact for readTimes.
+    const TimeNs t = frames[k].time_ns;
+    const TimeNs sec = t >= 0 ? t / 1000000000 : -((-t + 999999999) / 1000000000);
+    std::snprintf(line, sizeof(line), "%lld.%09lld\n", static_cast<long long>(sec),
+                  static_cast<long long>(t - sec * 1000000000));
+    times += line;
+    for (const StereoObservation& o : frames[k].observations) {
+      if (o.landmark_id < 0) continue;
+      std::snprintf(line, sizeof(line), "%zu,%lld,%.4f,%.4f,%.4f,%.4f\n", k,
+                    static_cast<long long>(o.landmark_id), o.u_left, o.v_left, o.u_right,
+                    o.v_right);
+      tracks += line;
+    }
+  }
+  SUNVO_RETURN_IF_ERROR(writeWholeFile(folder + "/times.txt", times));
+  SUNVO_RETURN_IF_ERROR(writeWholeFile(folder + "/tracks.csv", tracks));
+  if (gt_T_0_k.empty()) return Status::ok();
+  Trajectory gt;
+  gt.T_w_c = gt_T_0_k;
+  return writeKittiPoses(folder + "/gt_poses.txt", gt);
+}
+
 }  // namespace sunvo::files

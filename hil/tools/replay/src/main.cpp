@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "sunvo/cli/cli.hpp"
+#include "sunvo/files/tracks_io.hpp"
 #include "sunvo/files/trajectory_io.hpp"
 #include "sunvo/metrics/metrics.hpp"
 #include "sunvo/replay/replay.hpp"
@@ -93,6 +94,11 @@ int main(int argc, char** argv) {
   app.add_flag("!--no-error-models", error_models,
                "skip the error-model sun sources (pure VO and the image estimators only)");
   app.add_option("--model", model, "the Sun-CNN ONNX model");
+  std::string tracks_dir;
+  app.add_option("--write-tracks", tracks_dir,
+                 "also write the pure VO run's front-end tracks (before any self-calibration) as a "
+                 "track folder DIR (calib.txt, times.txt, tracks.csv, gt_poses.txt) for the "
+                 "track-mode tools");
   app.add_flag(
       "--poses", write_poses,
       "also write each run's poses, OUT/replay_poses_<run>.txt (KITTI) and _tum.txt (TUM)");
@@ -157,7 +163,8 @@ int main(int argc, char** argv) {
   const Eigen::Vector3d up_w = data->worldUp();
   for (std::size_t i = 0; i < plan.size(); ++i) {
     const Planned& p = plan[i];
-    const sunvo::replay::ReplayOptions& run_options = p.vertical ? vertical_options : options;
+    sunvo::replay::ReplayOptions run_options = p.vertical ? vertical_options : options;
+    run_options.record_features = i == 0 && !tracks_dir.empty();
     std::optional<sunvo::experiment::SunSourceSpec> spec;
     if (p.spec != nullptr) spec = *p.spec;
     auto run = sunvo::replay::replayDrive(*data, run_options, spec, p.image);
@@ -165,6 +172,21 @@ int main(int argc, char** argv) {
     // The ground truth of the frames processed (dropped frames have no pose).
     gt.clear();
     for (const std::size_t k : run->frame_index) gt.push_back(data->groundTruth()[k]);
+    if (run_options.record_features) {
+      std::filesystem::create_directories(tracks_dir, ec);
+      if (ec) {
+        return sunvo::cli::fail(kProgram, "cannot create '" + tracks_dir + "': " + ec.message());
+      }
+      std::vector<sunvo::Isometry3> gt_T_0_k;
+      for (const sunvo::Isometry3& T_w_k : gt) gt_T_0_k.push_back(gt.front().inverse() * T_w_k);
+      if (auto s =
+              sunvo::files::writeTrackFolder(tracks_dir, data->camera(), run->features, gt_T_0_k);
+          !s.isOk()) {
+        return sunvo::cli::fail(kProgram, s);
+      }
+      std::fprintf(stderr, "wrote %s/{calib.txt,times.txt,tracks.csv,gt_poses.txt} (%zu frames)\n",
+                   tracks_dir.c_str(), run->features.size());
+    }
     sunvo::metrics::EvaluationOptions eval_opt;
     eval_opt.plane = input.plane;
     auto ev = sunvo::metrics::evaluate(gt, run->T_w_c, eval_opt);

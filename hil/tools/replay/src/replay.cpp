@@ -150,6 +150,7 @@ Expected<ReplayRun> replayDrive(const dataset::Dataset& data, const ReplayOption
     if (options.pipeline.self_calibration.enabled) {
       run.self_calibration_log.push_back(r->self_calibration);
     }
+    if (options.record_features) run.features.push_back(vo.lastFeatures());
   }
   run.gate = vo.sunCounters();
   run.vertical_gate = vo.verticalCounters();

@@ -98,4 +98,13 @@ Expected<std::vector<FrameFeatures>> parseTracks(TextFile& file, const std::vect
 // (readTimes: exact decimal seconds to ns; readKittiPoses).
 Expected<TrackSequence> readTrackFolder(const std::string& folder, const TrackReadOptions& options);
 
+// Writes a track folder that readTrackFolder reads back: calib.txt with the camera's size,
+// times.txt (exact decimal seconds), tracks.csv (observations with a landmark id >= 0, in frame
+// order; frame k of the folder is frames[k], whatever its sequence) and, when gt_T_0_k is not
+// empty (one pose per frame), gt_poses.txt. The folder must exist. E.g. the front end's output of
+// an image drive (sunvo_replay --write-tracks), to run the track-mode tools on it.
+Status writeTrackFolder(const std::string& folder, const StereoCamera& camera,
+                        const std::vector<FrameFeatures>& frames,
+                        const std::vector<Isometry3>& gt_T_0_k);
+
 }  // namespace sunvo::files

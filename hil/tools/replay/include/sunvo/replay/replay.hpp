@@ -51,6 +51,9 @@ struct ReplayOptions {
   // Bad frames in a row that are dropped before the run stops with the last one's error, frames,
   // [0, 100000]; 0 = the first bad frame stops the run (and open() needs every image file).
   int max_consecutive_bad_frames = 10;
+  // Keep every processed frame's front-end output (ReplayRun::features), e.g. to write the drive's
+  // tracks as a track folder (files::writeTrackFolder).
+  bool record_features = false;
   // The fusion options of an image-estimator run: `fusion` with the cap above.
   sunfusion::SunFusionOptions imageFusion() const;
   Status validate() const;
@@ -72,6 +75,9 @@ struct ReplayRun {
   std::vector<double> sun_ms;                       // their wall times, ms
   selfcal::SelfCalibrationReport self_calibration;  // after the last frame (if enabled)
   std::vector<selfcal::SelfCalibrationReport> self_calibration_log;  // per frame (if enabled)
+  // Per processed frame, the front end's observations before any self-calibration correction
+  // (only with ReplayOptions::record_features).
+  std::vector<FrameFeatures> features;
 };
 
 // Opens the dataset of a replay; it must have images. An image estimator gets the colour images
