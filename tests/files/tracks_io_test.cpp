@@ -242,6 +242,7 @@ TEST(TracksIo, AWrittenFolderReadsBack) {
     }
   }
   frames[1].observations[2].landmark_id = -1;  // no landmark: not written
+  frames[2].observations[1].v_right_measured = false;
   ASSERT_TRUE(writeTrackFolder(dir.str(), camera, frames, gt).isOk());
   auto seq = readTrackFolder(dir.str(), TrackReadOptions{});
   ASSERT_TRUE(seq) << seq.status().toString();
@@ -257,6 +258,20 @@ TEST(TracksIo, AWrittenFolderReadsBack) {
   EXPECT_EQ(o.landmark_id, 5);
   EXPECT_NEAR(o.u_right, frames[2].observations[3].u_right, 1e-4);
   EXPECT_NEAR(o.v_right, frames[2].observations[3].v_right, 1e-4);
+  EXPECT_TRUE(o.v_right_measured);
+  EXPECT_FALSE(seq->frames[2].observations[1].v_right_measured);
+  // The optional column holds 0 or 1 only, and every row has it when the header does.
+  sunvo::testing::writeText(dir.file("bad/tracks.csv"),
+                            "frame,landmark,uL,vL,uR,vR,vR_measured\n0,1,10,10,5,10,2\n");
+  auto bad = TextFile::open(dir.file("bad/tracks.csv"));
+  ASSERT_TRUE(bad);
+  EXPECT_EQ(parseTracks(*bad, {0}, 1242, 375).status().message(),
+            dir.file("bad/tracks.csv") + ":2: field 'vR_measured': must be 0 or 1");
+  sunvo::testing::writeText(dir.file("bad/tracks.csv"),
+                            "frame,landmark,uL,vL,uR,vR,vR_measured\n0,1,10,10,5,10\n");
+  auto short_row = TextFile::open(dir.file("bad/tracks.csv"));
+  ASSERT_TRUE(short_row);
+  EXPECT_FALSE(parseTracks(*short_row, {0}, 1242, 375));
   // A pose list of the wrong length is refused before anything is written.
   gt.pop_back();
   EXPECT_EQ(writeTrackFolder(dir.str(), camera, frames, gt).message(),

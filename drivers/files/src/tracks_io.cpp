@@ -96,16 +96,21 @@ Expected<ParsedTracks> parseTracks(TextFile& file, const std::vector<TimeNs>& ti
   std::string_view line;
   // Header.
   bool have_header = false;
+  std::size_t columns = 6;  // 7 with the optional vR_measured
   while (file.nextLine(line)) {
     if (isBlank(line)) continue;
     const auto fields = splitFields(line, ',');
-    static constexpr const char* kHeader[6] = {"frame", "landmark", "uL", "vL", "uR", "vR"};
-    if (fields.size() != 6) return file.lineError("expected header 'frame,landmark,uL,vL,uR,vR'");
-    for (std::size_t i = 0; i < 6; ++i) {
+    static constexpr const char* kHeader[7] = {"frame", "landmark", "uL",         "vL",
+                                               "uR",    "vR",       "vR_measured"};
+    if (fields.size() != 6 && fields.size() != 7) {
+      return file.lineError("expected header 'frame,landmark,uL,vL,uR,vR[,vR_measured]'");
+    }
+    for (std::size_t i = 0; i < fields.size(); ++i) {
       if (fields[i] != kHeader[i]) {
         return file.error(kHeader[i], "unexpected header name '" + std::string(fields[i]) + "'");
       }
     }
+    columns = fields.size();
     have_header = true;
     break;
   }
@@ -123,9 +128,19 @@ Expected<ParsedTracks> parseTracks(TextFile& file, const std::vector<TimeNs>& ti
   while (file.nextLine(line)) {
     if (isBlank(line)) continue;
     const auto f = splitFields(line, ',');
-    if (f.size() != 6) {
-      return file.lineError("expected 6 fields 'frame,landmark,uL,vL,uR,vR', got " +
-                            std::to_string(f.size()));
+    if (f.size() != columns) {
+      return file.lineError(columns == 6 ? "expected 6 fields 'frame,landmark,uL,vL,uR,vR', got " +
+                                               std::to_string(f.size())
+                                         : "expected 7 fields 'frame,landmark,uL,vL,uR,vR,"
+                                           "vR_measured', got " +
+                                               std::to_string(f.size()));
+    }
+    bool v_right_measured = true;
+    if (columns == 7) {
+      auto m = file.parseInt(f[6], "vR_measured");
+      if (!m) return m.status();
+      if (*m != 0 && *m != 1) return file.error("vR_measured", "must be 0 or 1");
+      v_right_measured = *m == 1;
     }
     auto frame = file.parseInt(f[0], "frame");
     if (!frame) return frame.status();
@@ -181,6 +196,7 @@ Expected<ParsedTracks> parseTracks(TextFile& file, const std::vector<TimeNs>& ti
     o.v_left = px[1];
     o.u_right = px[2];
     o.v_right = px[3];
+    o.v_right_measured = v_right_measured;
     ff.observations.push_back(o);
   }
   return out;
@@ -290,7 +306,7 @@ Status writeTrackFolder(const std::string& folder, const StereoCamera& camera,
   std::snprintf(line, sizeof(line), "%.10g %.10g %.10g %.10g %.10g %d %d\n", camera.fu, camera.fv,
                 camera.cu, camera.cv, camera.baseline_m, camera.width, camera.height);
   SUNVO_RETURN_IF_ERROR(writeWholeFile(folder + "/calib.txt", line));
-  std::string times, tracks = "frame,landmark,uL,vL,uR,vR\n";
+  std::string times, tracks = "frame,landmark,uL,vL,uR,vR,vR_measured\n";
   for (std::size_t k = 0; k < frames.size(); ++k) {
     // Whole seconds and nanoseconds apart: exact for readTimes.
     const TimeNs t = frames[k].time_ns;
@@ -300,9 +316,9 @@ Status writeTrackFolder(const std::string& folder, const StereoCamera& camera,
     times += line;
     for (const StereoObservation& o : frames[k].observations) {
       if (o.landmark_id < 0) continue;
-      std::snprintf(line, sizeof(line), "%zu,%lld,%.4f,%.4f,%.4f,%.4f\n", k,
-                    static_cast<long long>(o.landmark_id), o.u_left, o.v_left, o.u_right,
-                    o.v_right);
+      std::snprintf(line, sizeof(line), "%zu,%lld,%.4f,%.4f,%.4f,%.4f,%d\n", k,
+                    static_cast<long long>(o.landmark_id), o.u_left, o.v_left, o.u_right, o.v_right,
+                    o.v_right_measured ? 1 : 0);
       tracks += line;
     }
   }

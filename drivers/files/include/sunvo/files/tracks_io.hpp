@@ -4,7 +4,9 @@
 //                 "width height" (px) of the rectified images
 //   times.txt     one frame time per line, seconds since the Unix epoch (read as UTC)
 //   tracks.csv    header "frame,landmark,uL,vL,uR,vR", then one observation per row, rows grouped
-//                 by frame in increasing frame order
+//                 by frame in increasing frame order; an optional 7th column vR_measured (0 or 1:
+//                 whether the right row was measured, StereoObservation::v_right_measured;
+//                 without it every row counts as measured)
 //   gt_poses.txt  optional: KITTI 3x4 poses T_0_k (camera k -> camera 0), 12 numbers per line
 //
 // Decisions:
