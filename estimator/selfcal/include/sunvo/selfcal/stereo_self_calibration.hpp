@@ -18,10 +18,11 @@
 //
 // Not estimated: a turn psi about the camera's y axis. It shifts every disparity by about fu psi
 // (0.13 px for 0.01 deg) but the rows only by -psi (uR - cu) (vR - cv) / fu (0.026 px in the image
-// corners). Both ways tried on rendered drives (docs/backend.md, 2026-11-26) failed on rigs turned
+// corners). The ways tried on rendered drives (docs/backend.md, 2026-11-26) failed on rigs turned
 // by 0: from that term psi came out 0.008-0.011 deg and a calibrated drive drifted 23 times as
-// far; from the motion (near and far points must agree on the depth change) the bias came out
-// 0.1-0.4 px and drives drifted 5-50 times as far. Not estimated until one of them holds there.
+// far; from the motion (near and far points must agree on the depth change, over one frame or
+// over 8-frame segments) the bias wandered by 0.1-0.4 px and drives drifted up to 50 times as
+// far. Not estimated until one of them holds there.
 //
 // Drift model. A rig warms and cools over minutes, so its error changes as a ramp more than as a
 // random walk: a random walk small enough to stay quiet on a steady rig trails a ramp by
