@@ -43,5 +43,17 @@ TEST(SunCsv, ErrorsNameFileLineAndField) {
   EXPECT_NE(count.status().message().find(":2: expected 4 fields"), std::string::npos);
 }
 
+TEST(SunCsv, WhatIsWrittenReadsBack) {
+  SunCsv sun;
+  sun.sun_c = {Eigen::Vector3d(0.6, -0.8, 0.0), Eigen::Vector3d(0.0, -0.6, 0.8)};
+  const std::string path = writeTemp("round_trip.csv", "");
+  ASSERT_TRUE(writeSunCsv(path, sun).isOk());
+  auto back = readSunCsv(path);
+  ASSERT_TRUE(back) << back.status().toString();
+  ASSERT_EQ(back->sun_c.size(), 2u);
+  EXPECT_NEAR((back->sun_c[1] - sun.sun_c[1]).norm(), 0.0, 1e-9);
+  std::filesystem::remove(path);
+}
+
 }  // namespace
 }  // namespace sunvo::files

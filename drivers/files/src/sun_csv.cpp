@@ -2,8 +2,10 @@
 
 #include <array>
 #include <cmath>
+#include <cstdio>
 
 #include "sunvo/files/text_file.hpp"
+#include "sunvo/files/trajectory_io.hpp"
 
 namespace sunvo::files {
 
@@ -46,6 +48,17 @@ Expected<SunCsv> readSunCsv(const std::string& path, double unit_tolerance) {
   }
   if (out.sun_c.empty()) return parseError(path + ": no data rows");
   return out;
+}
+
+Status writeSunCsv(const std::string& path, const SunCsv& sun) {
+  std::string text = "frame,sx,sy,sz\n";
+  char line[128];
+  for (std::size_t k = 0; k < sun.sun_c.size(); ++k) {
+    const Eigen::Vector3d& s = sun.sun_c[k];
+    std::snprintf(line, sizeof(line), "%zu,%.9f,%.9f,%.9f\n", k, s.x(), s.y(), s.z());
+    text += line;
+  }
+  return writeWholeFile(path, text);
 }
 
 }  // namespace sunvo::files

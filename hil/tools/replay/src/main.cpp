@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "sunvo/cli/cli.hpp"
+#include "sunvo/files/sun_csv.hpp"
 #include "sunvo/files/tracks_io.hpp"
 #include "sunvo/files/trajectory_io.hpp"
 #include "sunvo/metrics/metrics.hpp"
@@ -97,8 +98,8 @@ int main(int argc, char** argv) {
   std::string tracks_dir;
   app.add_option("--write-tracks", tracks_dir,
                  "also write the pure VO run's front-end tracks (before any self-calibration) as a "
-                 "track folder DIR (calib.txt, times.txt, tracks.csv, gt_poses.txt) for the "
-                 "track-mode tools");
+                 "track folder DIR (calib.txt, times.txt, tracks.csv, gt_poses.txt, sun_cam.csv) "
+                 "for the track-mode tools (sunvo_track_vo, sunvo_track_stats, sunvo_experiment)");
   app.add_flag(
       "--poses", write_poses,
       "also write each run's poses, OUT/replay_poses_<run>.txt (KITTI) and _tum.txt (TUM)");
@@ -184,7 +185,15 @@ int main(int argc, char** argv) {
           !s.isOk()) {
         return sunvo::cli::fail(kProgram, s);
       }
-      std::fprintf(stderr, "wrote %s/{calib.txt,times.txt,tracks.csv,gt_poses.txt} (%zu frames)\n",
+      // The true sun of the same frames: the folder is then a route of sunvo_experiment.
+      sunvo::files::SunCsv sun;
+      for (const std::size_t k : run->frame_index) sun.sun_c.push_back(data->trueSun()[k].sun_c);
+      if (auto s = sunvo::files::writeSunCsv(tracks_dir + "/sun_cam.csv", sun); !s.isOk()) {
+        return sunvo::cli::fail(kProgram, s);
+      }
+      std::fprintf(stderr,
+                   "wrote %s/{calib.txt,times.txt,tracks.csv,gt_poses.txt,sun_cam.csv} (%zu "
+                   "frames)\n",
                    tracks_dir.c_str(), run->features.size());
     }
     sunvo::metrics::EvaluationOptions eval_opt;

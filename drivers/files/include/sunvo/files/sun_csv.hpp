@@ -18,4 +18,7 @@ struct SunCsv {
 // and vectors whose norm is off 1 by more than unit_tolerance; errors name file, line and field.
 Expected<SunCsv> readSunCsv(const std::string& path, double unit_tolerance = 0.01);
 
+// Writes what readSunCsv reads: the header, then "k,sx,sy,sz" for k = 0..N-1 (9 decimals).
+Status writeSunCsv(const std::string& path, const SunCsv& sun);
+
 }  // namespace sunvo::files
