@@ -98,8 +98,9 @@ int main(int argc, char** argv) {
   std::string tracks_dir;
   app.add_option("--write-tracks", tracks_dir,
                  "also write the pure VO run's front-end tracks (before any self-calibration) as a "
-                 "track folder DIR (calib.txt, times.txt, tracks.csv, gt_poses.txt, sun_cam.csv) "
-                 "for the track-mode tools (sunvo_track_vo, sunvo_track_stats, sunvo_experiment)");
+                 "track folder DIR (calib.txt, times.txt, tracks.csv, gt_poses.txt, and "
+                 "sun_cam.csv when the drive knows the sun) for the track-mode tools "
+                 "(sunvo_track_vo, sunvo_track_stats, sunvo_experiment)");
   app.add_flag(
       "--poses", write_poses,
       "also write each run's poses, OUT/replay_poses_<run>.txt (KITTI) and _tum.txt (TUM)");
@@ -185,14 +186,17 @@ int main(int argc, char** argv) {
           !s.isOk()) {
         return sunvo::cli::fail(kProgram, s);
       }
-      // The true sun of the same frames: the folder is then a route of sunvo_experiment.
-      sunvo::files::SunCsv sun;
-      for (const std::size_t k : run->frame_index) sun.sun_c.push_back(data->trueSun()[k].sun_c);
-      if (auto s = sunvo::files::writeSunCsv(tracks_dir + "/sun_cam.csv", sun); !s.isOk()) {
-        return sunvo::cli::fail(kProgram, s);
+      // The true sun of the same frames (when the drive knows it): the folder is then a route of
+      // sunvo_experiment.
+      if (data->sunKnown() && data->trueSun().size() == data->size()) {
+        sunvo::files::SunCsv sun;
+        for (const std::size_t k : run->frame_index) sun.sun_c.push_back(data->trueSun()[k].sun_c);
+        if (auto s = sunvo::files::writeSunCsv(tracks_dir + "/sun_cam.csv", sun); !s.isOk()) {
+          return sunvo::cli::fail(kProgram, s);
+        }
       }
       std::fprintf(stderr,
-                   "wrote %s/{calib.txt,times.txt,tracks.csv,gt_poses.txt,sun_cam.csv} (%zu "
+                   "wrote %s/{calib.txt,times.txt,tracks.csv,gt_poses.txt[,sun_cam.csv]} (%zu "
                    "frames)\n",
                    tracks_dir.c_str(), run->features.size());
     }
