@@ -308,12 +308,8 @@ Status writeTrackFolder(const std::string& folder, const StereoCamera& camera,
   SUNVO_RETURN_IF_ERROR(writeWholeFile(folder + "/calib.txt", line));
   std::string times, tracks = "frame,landmark,uL,vL,uR,vR,vR_measured\n";
   for (std::size_t k = 0; k < frames.size(); ++k) {
-    // Whole seconds and nanoseconds apart: exact for readTimes.
-    const TimeNs t = frames[k].time_ns;
-    const TimeNs sec = t >= 0 ? t / 1000000000 : -((-t + 999999999) / 1000000000);
-    std::snprintf(line, sizeof(line), "%lld.%09lld\n", static_cast<long long>(sec),
-                  static_cast<long long>(t - sec * 1000000000));
-    times += line;
+    appendSecondsFromNs(times, frames[k].time_ns);
+    times.push_back('\n');
     for (const StereoObservation& o : frames[k].observations) {
       if (o.landmark_id < 0) continue;
       std::snprintf(line, sizeof(line), "%zu,%lld,%.4f,%.4f,%.4f,%.4f,%d\n", k,

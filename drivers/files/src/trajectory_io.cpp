@@ -29,7 +29,8 @@ void appendDouble(std::string& out, double v) {
   out.append(buf.data(), res.ptr);
 }
 
-// Seconds with exactly 9 decimals from integer ns (exact, no rounding through double).
+}  // namespace
+
 void appendSecondsFromNs(std::string& out, TimeNs t_ns) {
   if (t_ns < 0) {
     out.push_back('-');
@@ -44,8 +45,6 @@ void appendSecondsFromNs(std::string& out, TimeNs t_ns) {
   out.append(9 - frac_text.size(), '0');
   out += frac_text;
 }
-
-}  // namespace
 
 const char* toString(TrajectoryFormat format) {
   switch (format) {

@@ -179,8 +179,9 @@ int main(int argc, char** argv) {
       if (ec) {
         return sunvo::cli::fail(kProgram, "cannot create '" + tracks_dir + "': " + ec.message());
       }
+      const sunvo::Isometry3 T_0_w = gt.front().inverse();
       std::vector<sunvo::Isometry3> gt_T_0_k;
-      for (const sunvo::Isometry3& T_w_k : gt) gt_T_0_k.push_back(gt.front().inverse() * T_w_k);
+      for (const sunvo::Isometry3& T_w_k : gt) gt_T_0_k.push_back(T_0_w * T_w_k);
       if (auto s =
               sunvo::files::writeTrackFolder(tracks_dir, data->camera(), run->features, gt_T_0_k);
           !s.isOk()) {

@@ -79,4 +79,8 @@ Expected<TimeNs> parseSecondsToNs(const TextFile& file, std::string_view text,
 // Writes `content` to `path` (replacing it). kIoError names the path on failure.
 Status writeWholeFile(const std::string& path, std::string_view content);
 
+// Appends t_ns as seconds with exactly 9 decimals (exact, no rounding through double): what
+// parseTimes and the TUM reader read back to the nanosecond.
+void appendSecondsFromNs(std::string& out, TimeNs t_ns);
+
 }  // namespace sunvo::files
