@@ -30,16 +30,19 @@ FEAT, HIDDEN = 64 * 2 * 6, 128
 
 
 class SunCnn(nn.Module):
-    def __init__(self, channels, width=1):
+    def __init__(self, channels, width=1, depth=1):
         super().__init__()
         # 64x208 -> (5x5 stride-2 conv, pool) 16x52 -> 8x26 -> 4x13 -> 2x6 (x64 channels).
-        # width multiplies the channels of the first three convs (the last stays 64: FEAT).
+        # width multiplies the channels of the first three convs (the last stays 64: FEAT);
+        # depth is the number of 3x3 convs (each BN, ReLU) in each of the last three stages.
         c1, c2, c3 = 16 * width, 32 * width, 64 * width
         layers = [nn.Conv2d(channels, c1, 5, stride=2, padding=2, bias=False), nn.BatchNorm2d(c1),
                   nn.ReLU(), nn.MaxPool2d(2)]
         for a, b in ((c1, c2), (c2, c3), (c3, 64)):
-            layers += [nn.Conv2d(a, b, 3, padding=1, bias=False), nn.BatchNorm2d(b), nn.ReLU(),
-                       nn.MaxPool2d(2)]
+            for i in range(depth):
+                layers += [nn.Conv2d(a if i == 0 else b, b, 3, padding=1, bias=False),
+                           nn.BatchNorm2d(b), nn.ReLU()]
+            layers.append(nn.MaxPool2d(2))
         self.trunk = nn.Sequential(*layers)
         self.fc1 = nn.Linear(FEAT, HIDDEN)
         self.fc2 = nn.Linear(HIDDEN, 2)

@@ -117,7 +117,7 @@ def train_member(xtr, ttr, wtr, a, seed, log):
     epochs, channels = a.epochs, a.channels
     torch.manual_seed(seed)
     rng = np.random.default_rng(seed)
-    model = SunCnn(channels, a.width)
+    model = SunCnn(channels, a.width, a.depth)
     opt = torch.optim.AdamW(model.parameters(), lr=2e-3, weight_decay=1e-4)
     bs = 64
     steps = epochs * math.ceil(len(xtr) / bs)
@@ -221,6 +221,8 @@ def main():
     ap.add_argument("--members", type=int, default=3)
     ap.add_argument("--epochs", type=int, default=40)
     ap.add_argument("--width", type=int, default=1, help="channel multiplier of the trunk")
+    ap.add_argument("--depth", type=int, default=1,
+                    help="3x3 convs in each of the trunk's last three stages")
     ap.add_argument("--crop-min", type=float, default=0.75,
                     help="smallest random crop, share of each side")
     ap.add_argument("--threads", type=int, default=2)
@@ -288,6 +290,7 @@ def main():
         "training_command": "bash scripts/train_sun_cnn.sh",
         "epochs": a.epochs,
         "width": a.width,
+        "depth": a.depth,
         "crop_min": a.crop_min,
         "seed": a.seed,
         "train_seconds": round(train_s, 1),
