@@ -339,7 +339,7 @@ void StereoFrontend::measureRightRow(const Keypoint& lk, int ur, int sv,
   obs.v_right_measured = true;
   // The column from the same step: the parabola above is taken along row v, and where the right
   // row is off (a rig error; under 0.1 deg of roll up to 1 px at the image's corners) a slanted
-  // edge moves sideways with the row, which biases the disparity (docs/backend.md, measured).
+  // edge moves sideways with the row, which biases the disparity (docs/selfcal.md, measured).
   const double u_right = ur + du + static_cast<double>(lk.du);
   const double disparity = obs.u_left - u_right;
   if (std::isfinite(du) && std::abs(du) <= 1.0 && disparity >= options_.min_disparity &&

@@ -18,7 +18,7 @@
 //
 // Not estimated: a turn psi about the camera's y axis. It shifts every disparity by about fu psi
 // (0.13 px for 0.01 deg) but the rows only by -psi (uR - cu) (vR - cv) / fu (0.026 px in the image
-// corners). The ways tried on rendered drives (docs/backend.md, 2026-11-26) failed on rigs turned
+// corners). The ways tried on rendered drives (docs/selfcal.md, 2026-11-26) failed on rigs turned
 // by 0: from that term psi came out 0.008-0.011 deg and a calibrated drive drifted 23 times as
 // far; from the motion (near and far points must agree on the depth change, over one frame or
 // over 8-frame segments) the bias wandered by 0.1-0.4 px and drives drifted up to 50 times as
@@ -26,7 +26,7 @@
 //
 // Drift model. A rig warms and cools over minutes, so its error changes as a ramp more than as a
 // random walk: a random walk small enough to stay quiet on a steady rig trails a ramp by
-// rate / gain (0.04 deg behind a 3.3e-4 deg/frame ramp, docs/backend.md). So pitch and roll carry
+// rate / gain (0.04 deg behind a 3.3e-4 deg/frame ramp, docs/selfcal.md). So pitch and roll carry
 // a drift rate (rad/frame), a first-order Gauss-Markov process with stationary std
 // drift_rate_sigma_deg and correlation time drift_rate_time_frames (0 sigma: no rate state):
 //   x = (delta, theta, s, delta_dot, theta_dot),

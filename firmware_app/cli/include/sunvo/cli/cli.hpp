@@ -73,7 +73,7 @@ void addBiasStateOptions(CLI::App& app, FusionOptions& fusion) {
 }
 
 // The stereo self-calibration's drift rate (selfcal::StereoSelfCalibrationOptions,
-// docs/backend.md), the same in every program that runs it: --self-calib-rate-deg,
+// docs/selfcal.md), the same in every program that runs it: --self-calib-rate-deg,
 // --self-calib-rate-frames.
 template <class SelfCalibrationOptions>
 void addSelfCalibrationRateOptions(CLI::App& app, SelfCalibrationOptions& sc) {
