@@ -32,7 +32,8 @@ def main():
     ap.add_argument("--sigma-px", type=float, default=0.5, help="the filter's row sigma, px")
     ap.add_argument("--gate-px", type=float, default=1.5, help="residuals beyond are left out")
     a = ap.parse_args()
-    fu, fv, cu, cv = [float(x) for x in open(a.tracks + "/calib.txt").read().split()[:4]]
+    calib = [float(x) for x in open(a.tracks + "/calib.txt").read().split()]
+    fu, fv, cu, cv = calib[:4]
     d = np.genfromtxt(a.tracks + "/tracks.csv", delimiter=",", skip_header=1)
     if d.shape[1] < 7:
         raise SystemExit(f"{a.tracks}/tracks.csv: no vR_measured column (write it with --self-calib)")
@@ -81,17 +82,17 @@ def main():
     for i, name in ((0, "pitch"), (1, "roll")):
         e, t = est[:, i], truth[:, i]
         err = e - t
-        span = t.max() - t.min()
-        slope = (np.polyfit(t, e, 1)[0] if span > 1e-6 else float("nan"))
+        slope = (f", slope against the truth {np.polyfit(t, e, 1)[0]:.3f}"
+                 if t.max() - t.min() > 1e-6 else "")  # a constant truth has no slope
         print(f"per-frame {name} from the rows alone ({len(e)} frames): truth {t[0]:+.4f} -> "
               f"{t[-1]:+.4f} deg, error mean {err.mean():+.5f} deg (first / last 25 frames "
               f"{err[:25].mean():+.5f} / {err[-25:].mean():+.5f}), std {err.std():.5f} deg, "
-              f"lag-1 autocorrelation {np.corrcoef(err[:-1], err[1:])[0, 1]:.3f}"
-              + (f", slope against the truth {slope:.3f}" if span > 1e-6 else ""))
+              f"lag-1 autocorrelation {np.corrcoef(err[:-1], err[1:])[0, 1]:.3f}{slope}")
     print(f"the filter's per-frame roll sigma at {a.sigma_px} px: median "
           f"{math.degrees(np.median(sig)):.5f} deg")
-    for lo, hi in ((0, 0.15), (0.15, 0.35), (0.35, 0.5), (0.5, 0.65), (0.65, 0.85), (0.85, 1.01)):
-        w = 2 * cu
+    # Image width: calib.txt's sixth field where it states the size, else past the widest column.
+    w = calib[5] if len(calib) >= 7 else d[:, 4].max() + 1
+    for lo, hi in ((0, 0.15), (0.15, 0.35), (0.35, 0.5), (0.5, 0.65), (0.65, 0.85), (0.85, 1.0)):
         m = (d[:, 4] >= lo * w) & (d[:, 4] < hi * w)
         if m.sum() > 30:
             print(f"  uR {lo * w:6.0f}-{hi * w:6.0f} px: {m.sum():6d} rows, true offset "
