@@ -85,6 +85,40 @@ TEST(TrackStats, RecoversAnInjectedOffsetPlaneAndDisparityBias) {
     EXPECT_NEAR(b.mean_px, -0.3, 1e-5) << b.z_min_m;
   }
   EXPECT_GT(used, 100u);
+  ASSERT_EQ(s->fraction_bins.size(), 10u);
+  std::size_t by_fraction = 0;
+  for (const FractionBin& b : s->fraction_bins) {
+    by_fraction += b.n;
+    if (b.n > 0) {
+      EXPECT_NEAR(b.mean_px, -0.3, 1e-5) << b.f_min;
+    }
+  }
+  EXPECT_EQ(by_fraction, used);
+}
+
+// A written image drive's tracks carry vR = vL where the front end did not measure the right row
+// (v_right_measured false): those rows say nothing about the offset and must not pull it to 0.
+TEST(TrackStats, UnmeasuredRightRowsAreLeftOutOfTheOffsetPlane) {
+  const auto T_0_k = drive(80);
+  auto frames = cleanTracks(T_0_k);
+  const StereoCamera cam = kittiCamera();
+  std::size_t i = 0;
+  for (FrameFeatures& f : frames) {
+    for (StereoObservation& o : f.observations) {
+      if (i++ % 2 == 0) {
+        o.v_right_measured = false;  // vR stays vL
+      } else {
+        o.v_right -= 0.2 + 0.5e-3 * (o.u_left - cam.cu);
+      }
+    }
+  }
+  auto s = computeTrackStats(cam, frames, T_0_k, {}, TrackStatsOptions{});
+  ASSERT_TRUE(s) << s.status().toString();
+  EXPECT_NEAR(s->plane.a_px, 0.2, 1e-9);
+  EXPECT_NEAR(s->plane.b, 0.5e-3, 1e-12);
+  EXPECT_NEAR(s->plane.rms_px, 0.0, 1e-9);
+  ASSERT_FALSE(s->blocks.empty());
+  EXPECT_NEAR(s->blocks.front().a_px, 0.2, 1e-9);
 }
 
 TEST(TrackStats, AnEstimateWithARollKickIsAJump) {

@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <unordered_map>
 
@@ -83,6 +84,8 @@ void disparityVsDepth(const StereoCamera& cam, const std::vector<FrameFeatures>&
   static constexpr double kEdges[] = {0, 5, 10, 15, 20, 30, 40, 60, 1e9};
   constexpr std::size_t kBins = std::size(kEdges) - 1;
   std::vector<std::vector<double>> bins(kBins);
+  constexpr int kFractionBins = 10;  // 0.1 px each over [-0.5, 0.5)
+  std::vector<std::vector<double>> fraction_bins(kFractionBins);
   const double min_cos = std::cos(opt.min_parallax_deg * M_PI / 180.0);
   for (const auto& [id, obs] : tracks) {
     if (obs.size() < 3) continue;
@@ -110,7 +113,7 @@ void disparityVsDepth(const StereoCamera& cam, const std::vector<FrameFeatures>&
     const Eigen::Vector3d p_0 = A.ldlt().solve(b);
     if (!p_0.allFinite()) continue;
     bool good = true;
-    std::vector<std::pair<double, double>> zd;  // (z_k, d error)
+    std::vector<std::array<double, 3>> zd;  // (z_k, d error, d)
     for (const MonoObs& m : obs) {
       const Eigen::Vector3d p_k = T_0_k[m.frame].inverse() * p_0;
       if (!(p_k.z() > 0.5)) {
@@ -123,14 +126,17 @@ void disparityVsDepth(const StereoCamera& cam, const std::vector<FrameFeatures>&
         good = false;
         break;
       }
-      zd.emplace_back(p_k.z(), m.o->disparity() - cam.fu * cam.baseline_m / p_k.z());
+      const double d = m.o->disparity();
+      zd.push_back({p_k.z(), d - cam.fu * cam.baseline_m / p_k.z(), d});
     }
     if (!good) continue;
     ++out.mono_landmarks;
-    for (const auto& [z, e] : zd) {
+    for (const auto& [z, e, d] : zd) {
       for (std::size_t i = 0; i < kBins; ++i) {
         if (z >= kEdges[i] && z < kEdges[i + 1]) bins[i].push_back(e);
       }
+      const int f = static_cast<int>(std::floor((d - std::round(d) + 0.5) * kFractionBins));
+      fraction_bins[static_cast<std::size_t>(std::clamp(f, 0, kFractionBins - 1))].push_back(e);
     }
   }
   for (std::size_t i = 0; i < kBins; ++i) {
@@ -141,6 +147,16 @@ void disparityVsDepth(const StereoCamera& cam, const std::vector<FrameFeatures>&
     bin.mean_px = mean(bins[i]);
     bin.median_px = median(bins[i]);
     out.depth_bins.push_back(bin);
+  }
+  for (int i = 0; i < kFractionBins; ++i) {
+    auto& v = fraction_bins[static_cast<std::size_t>(i)];
+    FractionBin bin;
+    bin.f_min = -0.5 + static_cast<double>(i) / kFractionBins;
+    bin.f_max = bin.f_min + 1.0 / kFractionBins;
+    bin.n = v.size();
+    bin.mean_px = mean(v);
+    bin.median_px = median(v);
+    out.fraction_bins.push_back(bin);
   }
 }
 }  // namespace
@@ -230,6 +246,7 @@ Expected<TrackStats> computeTrackStats(const StereoCamera& cam,
       const int cy =
           std::clamp(static_cast<int>(o.v_left / cam.height * opt.grid_rows), 0, opt.grid_rows - 1);
       cell[static_cast<std::size_t>(cy * opt.grid_cols + cx)] = 1;
+      if (!o.v_right_measured) continue;  // vR is a copy of vL (a written image drive's tracks)
       const double offset = o.v_left - o.v_right;
       if (std::abs(offset) > opt.max_offset_px) {
         ++all_rejected;
@@ -321,6 +338,7 @@ Expected<TrackStats> computeTrackStats(const StereoCamera& cam,
     std::size_t rejected = 0;
     for (std::size_t k = b0; k < b1; ++k) {
       for (const StereoObservation& o : frames[k].observations) {
+        if (!o.v_right_measured) continue;
         const double offset = o.v_left - o.v_right;
         if (std::abs(offset) > opt.max_offset_px) {
           ++rejected;

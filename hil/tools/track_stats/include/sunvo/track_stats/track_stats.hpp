@@ -100,6 +100,14 @@ struct DepthBin {
   double mean_px = 0.0, median_px = 0.0;  // d_observed - fu b / z
 };
 
+// The same disparity error by the measured disparity's fractional part f = d - round(d) in
+// [f_min, f_max): a subpixel estimator drawn towards whole or half pixels errs by a pattern in f.
+struct FractionBin {
+  double f_min = 0.0, f_max = 0.0;
+  std::size_t n = 0;
+  double mean_px = 0.0, median_px = 0.0;  // d_observed - fu b / z
+};
+
 // Statistics of the observations whose track is `age` frames old (frames since its first
 // observation), age in [age_min, age_max].
 struct AgeBin {
@@ -138,6 +146,7 @@ struct TrackStats {
   OffsetPlane plane;                // whole drive
   std::vector<OffsetPlane> blocks;  // per block_frames
   std::vector<DepthBin> depth_bins;
+  std::vector<FractionBin> fraction_bins;  // 10 bins of 0.1 px over [-0.5, 0.5)
   std::size_t mono_landmarks = 0;  // landmarks the disparity check could use
   std::vector<AgeBin> ages;
   std::vector<ResidualDepthBin> residual_depths;
