@@ -22,7 +22,9 @@
 // by 0: from that term psi came out 0.008-0.011 deg and a calibrated drive drifted 23 times as
 // far; from the motion (near and far points must agree on the depth change, over one frame or
 // over 8-frame segments) the bias wandered by 0.1-0.4 px and drives drifted up to 50 times as
-// far. Not estimated until one of them holds there.
+// far. On the real 0020 tracks the rows' yaw term ran to -0.44 deg: the tracks sit above cv, so
+// its column correlates with the roll's (-0.75). Not estimated until one of them holds; those
+// renders aliased, and on antialiased ones the bias shows in the depths (docs/selfcal.md).
 //
 // Drift model. A rig warms and cools over minutes, so its error changes as a ramp more than as a
 // random walk: a random walk small enough to stay quiet on a steady rig trails a ramp by
