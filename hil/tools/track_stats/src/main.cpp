@@ -256,8 +256,9 @@ int main(int argc, char** argv) {
                 std::min(b.z_max_m, 999.0), b.n, b.mean_px, b.median_px);
   }
 
-  std::printf("\ndisparity error vs the disparity's fractional part f = d - round(d) (same "
-              "landmarks):\n");
+  std::printf(
+      "\ndisparity error vs the disparity's fractional part f = d - round(d) (same "
+      "landmarks):\n");
   for (const auto& b : stats->fraction_bins) {
     std::printf("  f [%+.1f, %+.1f) px: %6zu obs  mean %+.3f  median %+.3f px\n", b.f_min, b.f_max,
                 b.n, b.mean_px, b.median_px);

@@ -147,7 +147,7 @@ struct TrackStats {
   std::vector<OffsetPlane> blocks;  // per block_frames
   std::vector<DepthBin> depth_bins;
   std::vector<FractionBin> fraction_bins;  // 10 bins of 0.1 px over [-0.5, 0.5)
-  std::size_t mono_landmarks = 0;  // landmarks the disparity check could use
+  std::size_t mono_landmarks = 0;          // landmarks the disparity check could use
   std::vector<AgeBin> ages;
   std::vector<ResidualDepthBin> residual_depths;
   FlowFit flow;
