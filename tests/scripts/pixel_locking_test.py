@@ -1,12 +1,13 @@
 #!/usr/bin/env python3
 """Tests of scripts/pixel_locking.py on small track folders written here."""
-import argparse
 import os
 import random
 import subprocess
 import sys
 import tempfile
 import unittest
+
+import script_test
 
 SCRIPT = None
 
@@ -53,8 +54,4 @@ class PixelLocking(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    parser = argparse.ArgumentParser()
-    parser.add_argument("--script", required=True)
-    args, rest = parser.parse_known_args()
-    SCRIPT = args.script
-    unittest.main(argv=[sys.argv[0], *rest])
+    script_test.main(sys.modules[__name__])

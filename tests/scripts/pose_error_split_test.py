@@ -1,12 +1,13 @@
 #!/usr/bin/env python3
 """Tests of scripts/pose_error_split.py on small pose files written here."""
-import argparse
 import math
 import os
 import subprocess
 import sys
 import tempfile
 import unittest
+
+import script_test
 
 SCRIPT = None
 
@@ -52,8 +53,4 @@ class PoseErrorSplit(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    parser = argparse.ArgumentParser()
-    parser.add_argument("--script", required=True)
-    args, rest = parser.parse_known_args()
-    SCRIPT = args.script
-    unittest.main(argv=[sys.argv[0], *rest])
+    script_test.main(sys.modules[__name__])

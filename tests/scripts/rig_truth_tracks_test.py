@@ -1,7 +1,6 @@
 #!/usr/bin/env python3
 """Tests of scripts/rig_truth_tracks.py: right observations seen by a turned camera come back to
 where the nominal camera sees them."""
-import argparse
 import csv
 import math
 import os
@@ -9,6 +8,8 @@ import subprocess
 import sys
 import tempfile
 import unittest
+
+import script_test
 
 SCRIPT = None
 FU, FV, CU, CV = 700.0, 700.0, 600.0, 180.0
@@ -90,8 +91,4 @@ class RigTruthTracks(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    parser = argparse.ArgumentParser()
-    parser.add_argument("--script", required=True)
-    args, rest = parser.parse_known_args()
-    SCRIPT = args.script
-    unittest.main(argv=[sys.argv[0], *rest])
+    script_test.main(sys.modules[__name__])
