@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""A rendered drive's tracks with its injected rig error taken out exactly (issue 15, docs/selfcal.md).
+"""A rendered drive's tracks with its injected rig error taken out exactly (issue 15).
 
 An oracle for the self-calibration: what pure VO would do if it knew the right camera's turn. Reads
 a track folder written by `sunvo_replay --drive D --no-error-models --write-tracks T` (the right
@@ -11,7 +11,7 @@ the ray r = ((uR - cu) / fu, (vR - cv) / fv, 1) of the turned camera is turned b
 r_nom = R r, and projected. Only the axes named by --axes are taken out (the others stay in the
 observations), so `--axes yaw` is the rig error the self-calibration does not model. A row that
 was not measured (vR_measured 0: vR is a copy of vL) keeps its vR. Then
-`sunvo_track_vo OUT out.txt [--self-calib]` runs on it.
+`sunvo_track_vo OUT out.txt [--self-calib]` runs on it (docs/selfcal.md).
 No dependencies beyond Python. Usage: rig_truth_tracks.py TRACKS RIG_ERROR_CSV OUT [--axes
 roll,pitch,yaw]
 """
@@ -37,7 +37,8 @@ def rotation(roll, pitch, yaw):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("tracks", help="track folder (calib.txt, times.txt, tracks.csv[, gt_poses.txt])")
+    ap.add_argument("tracks",
+                    help="track folder (calib.txt, times.txt, tracks.csv[, gt_poses.txt])")
     ap.add_argument("rig_error", help="the drive's gt/rig_error.csv")
     ap.add_argument("out", help="the folder to write (created)")
     ap.add_argument("--axes", default="roll,pitch,yaw", help="axes to take out, comma separated")
@@ -69,7 +70,9 @@ def main():
     moved = 0
     with open(src, newline="") as f, open(os.path.join(a.out, "tracks.csv"), "w") as out:
         rows = csv.reader(f)
-        header = next(rows)
+        header = next(rows, None)
+        if header is None or header[:6] != ["frame", "landmark", "uL", "vL", "uR", "vR"]:
+            raise SystemExit(f"{src}:1: expected the header frame,landmark,uL,vL,uR,vR")
         out.write(",".join(header) + "\n")
         measured_col = header.index("vR_measured") if "vR_measured" in header else -1
         for line, row in enumerate(rows, start=2):
