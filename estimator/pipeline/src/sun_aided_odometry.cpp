@@ -118,7 +118,10 @@ Expected<vo::VoResult> SunAidedOdometry::process(const FrameFeatures& frame) {
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   }
   Expected<vo::VoResult> r = tracks_.process(*in);
-  if (r) T_w_c_ = r->T_w_c;
+  if (r) {
+    T_w_c_ = r->T_w_c;
+    if (selfcal_.enabled()) selfcal_.observeMotion(r->T_w_c, vo::trackedFromPrevious(*r));
+  }
   return r;
 }
 
