@@ -128,8 +128,9 @@ Expected<FrameResult> StereoImageOdometry::process(const StereoFrame& frame) {
   r.odometry_counter_delta = c2 - c1;
 
   // A motion is a measurement only when this frame was tracked against its predecessor.
-  const bool tracked = vo::trackedFromPrevious(r.vo);
-  if (self_calibration_.enabled()) self_calibration_.observeMotion(r.vo.T_w_c, tracked);
+  const bool tracked = (r.vo.status == vo::TrackingStatus::kTracking ||
+                        r.vo.status == vo::TrackingStatus::kRecovered) &&
+                       r.vo.reference_gap == 1;
   have_motion_ = tracked;
   if (tracked) last_motion_ = r.vo.T_k_km1;
 

@@ -118,10 +118,7 @@ Expected<vo::VoResult> SunAidedOdometry::process(const FrameFeatures& frame) {
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   }
   Expected<vo::VoResult> r = tracks_.process(*in);
-  if (r) {
-    T_w_c_ = r->T_w_c;
-    if (selfcal_.enabled()) selfcal_.observeMotion(r->T_w_c, vo::trackedFromPrevious(*r));
-  }
+  if (r) T_w_c_ = r->T_w_c;
   return r;
 }
 

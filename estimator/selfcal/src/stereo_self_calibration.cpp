@@ -39,10 +39,6 @@ Status StereoSelfCalibrationOptions::validate() const {
   if (min_observations < 3 || min_observations > 100000) {
     return bad("min_observations", "[3, 100000]");
   }
-  if (yaw.enabled && !enabled) {
-    return invalidArgument("self_calibration.yaw.enabled needs self_calibration.enabled");
-  }
-  SUNVO_RETURN_IF_ERROR(yaw.validate());
   return Status::ok();
 }
 
@@ -67,7 +63,7 @@ Status StereoSelfCalibration::init(const StereoSelfCalibrationOptions& options,
   max_rate_ = 10.0 * sr;
   resets_ = 0;
   resetState();
-  return yaw_.init(options.yaw, camera);
+  return Status::ok();
 }
 
 void StereoSelfCalibration::resetState() {
@@ -120,41 +116,32 @@ SelfCalibrationReport StereoSelfCalibration::process(const FrameFeatures& in, Fr
       std::abs(x_[3]) > max_rate_ || std::abs(x_[4]) > max_rate_) {
     resetState();
     ++resets_;
-    r.reset = true;  // this frame's rows go on as measured
-  } else {
-    // Correct the right observations (the inverse of the model above).
-    const double delta = x_[0], theta = x_[1], s = x_[2];
-    for (StereoObservation& o : out->observations) {
-      const double u = o.u_right, v = o.v_right;
-      o.u_right = u + theta * (v - cv);
-      o.v_right = v - fv * delta - theta * (u - cu) - s * (v - cv);
-    }
+    r.reset = true;
+    r.resets = resets_;
+    return r;  // this frame goes on as measured
   }
-  // The yaw measures from the rows' corrected observations and corrects them after.
-  yaw_.setFrame(*out);
-  yaw_.correct(out);
-  const YawReport& yr = yaw_.report();
-  r.yaw_mrad = yr.psi_rad * 1e3;
-  r.yaw_sigma_mrad = options_.yaw.enabled ? yr.sigma_rad * 1e3 : 0.0;
-  r.yaw_segments = yr.segments;
-  r.yaw_refused = yr.refused;
-  r.yaw_resets = yr.resets;
-  r.resets = resets_;
-  if (r.reset) return r;
-  r.pitch_mrad = x_[0] * 1e3;
-  r.roll_mrad = x_[1] * 1e3;
-  r.scale = x_[2];
+  // Correct the right observations (the inverse of the model above).
+  const double delta = x_[0], theta = x_[1], s = x_[2];
+  for (StereoObservation& o : out->observations) {
+    const double u = o.u_right, v = o.v_right;
+    o.u_right = u + theta * (v - cv);
+    o.v_right = v - fv * delta - theta * (u - cu) - s * (v - cv);
+  }
+  r.pitch_mrad = delta * 1e3;
+  r.roll_mrad = theta * 1e3;
+  r.scale = s;
   r.roll_sigma_mrad = std::sqrt(P_(1, 1)) * 1e3;
   r.pitch_rate_urad = x_[3] * 1e6;
   r.roll_rate_urad = x_[4] * 1e6;
+  r.resets = resets_;
   return r;
 }
 
 std::string reportCsvRow(std::size_t frame, const SelfCalibrationReport& r) {
-  char row[240];
-  std::snprintf(row, sizeof(row), "%zu,%.5f,%.5f,%.7f,%.5f,%d,%d,%.4f,%.4f,%.5f,%.5f\n", frame,
-                r.pitch_mrad, r.roll_mrad, r.scale, r.roll_sigma_mrad, r.used, r.reset ? 1 : 0,
-                r.pitch_rate_urad, r.roll_rate_urad, r.yaw_mrad, r.yaw_sigma_mrad);
+  char row[200];
+  std::snprintf(row, sizeof(row), "%zu,%.5f,%.5f,%.7f,%.5f,%d,%d,%.4f,%.4f\n", frame, r.pitch_mrad,
+                r.roll_mrad, r.scale, r.roll_sigma_mrad, r.used, r.reset ? 1 : 0, r.pitch_rate_urad,
+                r.roll_rate_urad);
   return row;
 }
 

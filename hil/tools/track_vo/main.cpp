@@ -188,12 +188,9 @@ int main(int argc, char** argv) {
     const sunvo::selfcal::SelfCalibrationReport& rep = vo.lastSelfCalibration();
     std::printf(
         "self-calibration: right camera pitch %.4f mrad, roll %.4f mrad, vertical scale "
-        "%.6f at the end; %llu resets; yaw %.4f mrad (%llu segments, %llu refused, %llu resets); "
-        "%.4f ms/frame median\n",
+        "%.6f at the end; %llu resets; %.4f ms/frame median\n",
         rep.pitch_mrad, rep.roll_mrad, rep.scale, static_cast<unsigned long long>(rep.resets),
-        rep.yaw_mrad, static_cast<unsigned long long>(rep.yaw_segments),
-        static_cast<unsigned long long>(rep.yaw_refused),
-        static_cast<unsigned long long>(rep.yaw_resets), percentile(selfcal_ms, 50));
+        percentile(selfcal_ms, 50));
   }
   sunvo::files::Trajectory out_traj;
   out_traj.T_w_c = poses;

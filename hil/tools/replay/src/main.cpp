@@ -240,18 +240,13 @@ int main(int argc, char** argv) {
         return sunvo::cli::fail(kProgram, s);
       }
       const auto& sc = run->self_calibration;
-      std::fprintf(
-          stderr,
-          "  %-28s self-calibration: right pitch %+.4f deg, roll %+.4f deg (sigma "
-          "%.4f), scale %+.2e, %llu resets; yaw %+.4f deg (sigma %.4f), %llu segments, "
-          "%llu refused, %llu resets\n",
-          "", sc.pitch_mrad * 0.180 / 3.141592653589793, sc.roll_mrad * 0.180 / 3.141592653589793,
-          sc.roll_sigma_mrad * 0.180 / 3.141592653589793, sc.scale,
-          static_cast<unsigned long long>(sc.resets), sc.yaw_mrad * 0.180 / 3.141592653589793,
-          sc.yaw_sigma_mrad * 0.180 / 3.141592653589793,
-          static_cast<unsigned long long>(sc.yaw_segments),
-          static_cast<unsigned long long>(sc.yaw_refused),
-          static_cast<unsigned long long>(sc.yaw_resets));
+      std::fprintf(stderr,
+                   "  %-28s self-calibration: right pitch %+.4f deg, roll %+.4f deg (sigma "
+                   "%.4f), scale %+.2e, %llu resets\n",
+                   "", sc.pitch_mrad * 0.180 / 3.141592653589793,
+                   sc.roll_mrad * 0.180 / 3.141592653589793,
+                   sc.roll_sigma_mrad * 0.180 / 3.141592653589793, sc.scale,
+                   static_cast<unsigned long long>(sc.resets));
     }
     if (run->sun_calls > 0) {
       std::fprintf(stderr, "  %-28s %d estimator calls, %.1f ms median, %.1f ms p90\n", "",

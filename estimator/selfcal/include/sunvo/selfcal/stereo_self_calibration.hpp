@@ -16,17 +16,15 @@
 // disparity (the paper's (u, v, d) residual never uses vR). The scale is estimated so that it does
 // not leak into the roll, and is not applied to uR.
 //
-// Not estimated from the rows: a turn psi about the camera's y axis. It shifts every disparity by
-// about fu psi (0.13 px for 0.01 deg) but the rows only by -psi (uR - cu) (vR - cv) / fu (0.026 px
-// in the image corners). The ways tried on rendered drives (docs/selfcal.md, 2026-11-26) failed on
-// rigs turned by 0: from that term psi came out 0.008-0.011 deg and a calibrated drive drifted 23
-// times as far; from the motion (near and far points must agree on the depth change, over one frame
-// or over 8-frame segments) the bias wandered by 0.1-0.4 px and drives drifted up to 50 times as
+// Not estimated: a turn psi about the camera's y axis. It shifts every disparity by about fu psi
+// (0.13 px for 0.01 deg) but the rows only by -psi (uR - cu) (vR - cv) / fu (0.026 px in the image
+// corners). The ways tried on rendered drives (docs/selfcal.md, 2026-11-26) failed on rigs turned
+// by 0: from that term psi came out 0.008-0.011 deg and a calibrated drive drifted 23 times as
+// far; from the motion (near and far points must agree on the depth change, over one frame or
+// over 8-frame segments) the bias wandered by 0.1-0.4 px and drives drifted up to 50 times as
 // far. On the real 0020 tracks the rows' yaw term ran to -0.44 deg: the tracks sit above cv, so
 // its column correlates with the roll's (-0.75). Not estimated until one of them holds; those
-// renders aliased, and on antialiased ones the bias shows in the depths (docs/selfcal.md). It
-// is estimated from the motion instead, when self_calibration.yaw.enabled: see yaw_from_motion.hpp
-// (observeMotion gives it the odometry's motion; the yaw correction follows the pitch and roll's).
+// renders aliased, and on antialiased ones the bias shows in the depths (docs/selfcal.md).
 //
 // Drift model. A rig warms and cools over minutes, so its error changes as a ramp more than as a
 // random walk: a random walk small enough to stay quiet on a steady rig trails a ramp by
@@ -54,7 +52,6 @@
 #include "sunvo/core/camera.hpp"
 #include "sunvo/core/features.hpp"
 #include "sunvo/core/status.hpp"
-#include "sunvo/selfcal/yaw_from_motion.hpp"
 
 namespace sunvo::selfcal {
 
@@ -74,7 +71,6 @@ struct StereoSelfCalibrationOptions {
   double max_angle_deg = 1.0;              // deg, (0, 10]: larger pitch or roll is a divergence
   double max_scale = 0.01;                 // 1, (0, 0.1]: larger |s| is a divergence
   int min_observations = 10;               // count, [3, 100000]: fewer in a frame: no update
-  YawFromMotionOptions yaw;                // the yaw from the motion (needs `enabled`)
 
   Status validate() const;
   template <class Self, class V>
@@ -91,35 +87,28 @@ struct StereoSelfCalibrationOptions {
     v("max_angle_deg", s.max_angle_deg);
     v("max_scale", s.max_scale);
     v("min_observations", s.min_observations);
-    v("yaw", s.yaw);
   }
 };
 
 // Per frame.
 struct SelfCalibrationReport {
-  double pitch_mrad = 0.0;         // delta after this frame's update
-  double roll_mrad = 0.0;          // theta
-  double scale = 0.0;              // s
-  double roll_sigma_mrad = 0.0;    // sqrt(P(1, 1))
-  double pitch_rate_urad = 0.0;    // delta_dot, urad per frame (0 without the rate state)
-  double roll_rate_urad = 0.0;     // theta_dot
-  double yaw_mrad = 0.0;           // psi (yaw_from_motion.hpp), as of the last completed segment
-  double yaw_sigma_mrad = 0.0;     // its std
-  std::uint64_t yaw_segments = 0;  // segments used, refused and divergences since init
-  std::uint64_t yaw_refused = 0;
-  std::uint64_t yaw_resets = 0;
-  int used = 0;              // observations in the update
-  int gated = 0;             // observations beyond gate_px
-  bool updated = false;      // false: too few observations (prediction only) or disabled
-  bool reset = false;        // this frame diverged and was reset
-  std::uint64_t resets = 0;  // since init
+  double pitch_mrad = 0.0;       // delta after this frame's update
+  double roll_mrad = 0.0;        // theta
+  double scale = 0.0;            // s
+  double roll_sigma_mrad = 0.0;  // sqrt(P(1, 1))
+  double pitch_rate_urad = 0.0;  // delta_dot, urad per frame (0 without the rate state)
+  double roll_rate_urad = 0.0;   // theta_dot
+  int used = 0;                  // observations in the update
+  int gated = 0;                 // observations beyond gate_px
+  bool updated = false;          // false: too few observations (prediction only) or disabled
+  bool reset = false;            // this frame diverged and was reset
+  std::uint64_t resets = 0;      // since init
 };
 
 // The per-frame log of the programs that run it (sunvo_track_vo --self-calib-log, sunvo_replay
 // --self-calib): the CSV header, and the row of frame `frame`; each line ends in '\n'.
 inline constexpr const char* kReportCsvHeader =
-    "frame,pitch_mrad,roll_mrad,scale,roll_sigma_mrad,used,reset,pitch_rate_urad,roll_rate_urad,"
-    "yaw_mrad,yaw_sigma_mrad\n";
+    "frame,pitch_mrad,roll_mrad,scale,roll_sigma_mrad,used,reset,pitch_rate_urad,roll_rate_urad\n";
 std::string reportCsvRow(std::size_t frame, const SelfCalibrationReport& r);
 
 class StereoSelfCalibration {
@@ -130,11 +119,6 @@ class StereoSelfCalibration {
   // Estimates from `in`, then writes `in` with corrected right observations to `out` (its vector
   // is reused: no allocation once its capacity suffices). Disabled: out = in.
   SelfCalibrationReport process(const FrameFeatures& in, FrameFeatures* out);
-  // After the odometry has processed the frame last given to process: its pose T_w_c and
-  // whether it was tracked from the previous frame (the yaw's segments; nothing without it).
-  void observeMotion(const Eigen::Isometry3d& T_w_c, bool tracked) {
-    if (options_.enabled) yaw_.addPose(T_w_c, tracked);
-  }
 
   // (delta rad, theta rad, s, delta_dot rad/frame, theta_dot rad/frame)
   const Eigen::Matrix<double, 5, 1>& state() const { return x_; }
@@ -154,7 +138,6 @@ class StereoSelfCalibration {
   Mat5 Q_ = Mat5::Zero();
   double max_rate_ = 0.0;  // rad/frame: 10 stationary stds
   std::uint64_t resets_ = 0;
-  YawFromMotion yaw_;
 };
 
 }  // namespace sunvo::selfcal

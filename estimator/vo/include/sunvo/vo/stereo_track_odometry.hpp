@@ -74,12 +74,6 @@ struct VoResult {
                                // frame was bridged; 0 = none)
 };
 
-// Whether the frame's motion was measured against the frame just before it.
-inline bool trackedFromPrevious(const VoResult& r) {
-  return (r.status == TrackingStatus::kTracking || r.status == TrackingStatus::kRecovered) &&
-         r.reference_gap == 1;
-}
-
 class StereoTrackOdometry {
  public:
   Status init(const VoOptions& options, const StereoCamera& camera, const Isometry3& T_w_c0);

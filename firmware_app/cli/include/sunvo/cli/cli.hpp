@@ -74,8 +74,7 @@ void addBiasStateOptions(CLI::App& app, FusionOptions& fusion) {
 
 // The stereo self-calibration's drift rate (selfcal::StereoSelfCalibrationOptions,
 // docs/selfcal.md), the same in every program that runs it: --self-calib-rate-deg,
-// --self-calib-rate-frames, and the yaw from the motion: --self-calib-yaw,
-// --self-calib-yaw-frames.
+// --self-calib-rate-frames.
 template <class SelfCalibrationOptions>
 void addSelfCalibrationRateOptions(CLI::App& app, SelfCalibrationOptions& sc) {
   app.add_option("--self-calib-rate-deg", sc.drift_rate_sigma_deg,
@@ -85,12 +84,6 @@ void addSelfCalibrationRateOptions(CLI::App& app, SelfCalibrationOptions& sc) {
   app.add_option("--self-calib-rate-frames", sc.drift_rate_time_frames,
                  "correlation time of that drift rate, frames")
       ->check(CLI::Range(1.0, 1e7));
-  app.add_flag("--self-calib-yaw", sc.yaw.enabled,
-               "with --self-calib: also the right camera's yaw (a disparity bias) from the "
-               "motion, in segments of --self-calib-yaw-frames");
-  app.add_option("--self-calib-yaw-frames", sc.yaw.segment_frames,
-                 "frames per segment of that yaw estimate")
-      ->check(CLI::Range(2, 100));
 }
 
 }  // namespace sunvo::cli
