@@ -23,8 +23,11 @@
 // far; from the motion (near and far points must agree on the depth change, over one frame or
 // over 8-frame segments) the bias wandered by 0.1-0.4 px and drives drifted up to 50 times as
 // far. On the real 0020 tracks the rows' yaw term ran to -0.44 deg: the tracks sit above cv, so
-// its column correlates with the roll's (-0.75). Not estimated until one of them holds; those
-// renders aliased, and on antialiased ones the bias shows in the depths (docs/selfcal.md).
+// its column correlates with the roll's (-0.75). On antialiased validation drives (session 15)
+// neither held either: the bias from the motion with the motion refitted per 8-frame segment is
+// right only to +-0.03 px over 150 frames and made every drive drift more (0.066 -> 0.358 m on a
+// calibrated one), and read -1.1 px on 0020; the rows' yaw term took 0.01-0.02 deg from the roll.
+// Not estimated: a rig's yaw needs an offline calibration (docs/selfcal.md).
 //
 // Drift model. A rig warms and cools over minutes, so its error changes as a ramp more than as a
 // random walk: a random walk small enough to stay quiet on a steady rig trails a ramp by
