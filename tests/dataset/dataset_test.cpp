@@ -38,7 +38,7 @@ std::string writeRawDrive(const TempDir& dir, const TimeNs t0_utc_ns) {
   const cv::Mat gray(375, 1242, CV_8UC1, cv::Scalar(90));
   const cv::Mat colour(375, 1242, CV_8UC3, cv::Scalar(90, 100, 110));
   for (int cam = 0; cam < 4; ++cam) {
-    char folder[16];
+    char folder[24];  // room for any int (gcc -O1 checks the whole range)
     std::snprintf(folder, sizeof(folder), "image_%02d", cam);
     fs::create_directories(drive / folder / "data");
     EXPECT_TRUE(

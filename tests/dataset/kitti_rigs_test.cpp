@@ -67,7 +67,7 @@ TEST(KittiRigs, SequencesNameTheirRawDrives) {
   EXPECT_EQ(kittiOdometryDrive("06"), "2011_09_30_drive_0020");
   // Each drive was recorded on its rig's day.
   for (int n = 0; n <= 10; ++n) {
-    char seq[8];
+    char seq[16];  // room for any int (gcc -O1 checks the whole range)
     std::snprintf(seq, sizeof(seq), "%02d", n);
     EXPECT_EQ(kittiOdometryDrive(seq)->substr(0, 10), kittiOdometryRig(seq)->date) << seq;
   }
