@@ -80,8 +80,9 @@ TEST(ClockJump, WallClockStepsBothWaysAreCountedAndNeitherPosesNorFrameTimesJump
     }
   });
 
-  // Three phases of 1 s (4 s under an emulator), the supervisor ticking every 20 ms as sunvo_rover's main thread does;
-  // the wall clock steps +1 h before the second, -1 h before the third.
+  // Three phases of 1 s (4 s under an emulator), the supervisor ticking every 20 ms as
+  // sunvo_rover's main thread does; the wall clock steps +1 h before the second, -1 h before the
+  // third.
   bool fault = false;
   std::vector<std::uint64_t> poses_at;  // poses published when each phase ends
   std::vector<TimeNs> jump_mono;        // when each step was injected
