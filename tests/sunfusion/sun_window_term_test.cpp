@@ -5,6 +5,8 @@
 #include <Eigen/Eigenvalues>
 #include <cmath>
 #include <random>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "sunvo/sunfusion/simulated_sun_source.hpp"
@@ -566,40 +568,27 @@ TEST_F(SunWindowTermTest, MedianRuleFollowsTheSizeOfTheInnovations) {
 }
 
 TEST(SunFusionOptionsTest, ValidationNamesTheBadKey) {
-  SunFusionOptions opt;
-  EXPECT_TRUE(opt.validate().isOk());
-  opt.min_drift_deg_per_frame = 1.0;  // above max
-  EXPECT_NE(opt.validate().toString().find("min_drift_deg_per_frame"), std::string::npos);
-  opt = SunFusionOptions{};
-  opt.drift_adaptation_rate = 0.0;
-  EXPECT_NE(opt.validate().toString().find("drift_adaptation_rate"), std::string::npos);
-  opt = SunFusionOptions{};
-  opt.persistence_false_alarm = 0.0;
-  EXPECT_NE(opt.validate().toString().find("persistence_false_alarm"), std::string::npos);
-  opt = SunFusionOptions{};
-  opt.persistence_forgetting = 1.0;
-  EXPECT_NE(opt.validate().toString().find("persistence_forgetting"), std::string::npos);
-  opt = SunFusionOptions{};
-  opt.innovation_gate_chi2 = -1.0;
-  EXPECT_NE(opt.validate().toString().find("innovation_gate_chi2"), std::string::npos);
-  opt = SunFusionOptions{};
-  opt.evidence_sigmas = 0.0;
-  EXPECT_NE(opt.validate().toString().find("evidence_sigmas"), std::string::npos);
-  opt = SunFusionOptions{};
-  opt.evidence_forgetting = 1.0;
-  EXPECT_NE(opt.validate().toString().find("evidence_forgetting"), std::string::npos);
-  opt = SunFusionOptions{};
-  opt.evidence_correlation = 0.5;
-  EXPECT_NE(opt.validate().toString().find("evidence_correlation"), std::string::npos);
-  opt = SunFusionOptions{};
-  opt.max_correction_deg = -1.0;
-  EXPECT_NE(opt.validate().toString().find("max_correction_deg"), std::string::npos);
-  opt = SunFusionOptions{};
-  opt.sun_bias_sigma_deg = 50.0;
-  EXPECT_NE(opt.validate().toString().find("sun_bias_sigma_deg"), std::string::npos);
-  opt = SunFusionOptions{};
-  opt.sun_bias_length_frames = 0.0;
-  EXPECT_NE(opt.validate().toString().find("sun_bias_length_frames"), std::string::npos);
+  EXPECT_TRUE(SunFusionOptions{}.validate().isOk());
+  using Set = void (*)(SunFusionOptions&);
+  const std::vector<std::pair<Set, const char*>> cases = {
+      // min_drift: above max_drift
+      {[](SunFusionOptions& o) { o.min_drift_deg_per_frame = 1.0; }, "min_drift_deg_per_frame"},
+      {[](SunFusionOptions& o) { o.drift_adaptation_rate = 0.0; }, "drift_adaptation_rate"},
+      {[](SunFusionOptions& o) { o.persistence_false_alarm = 0.0; }, "persistence_false_alarm"},
+      {[](SunFusionOptions& o) { o.persistence_forgetting = 1.0; }, "persistence_forgetting"},
+      {[](SunFusionOptions& o) { o.innovation_gate_chi2 = -1.0; }, "innovation_gate_chi2"},
+      {[](SunFusionOptions& o) { o.evidence_sigmas = 0.0; }, "evidence_sigmas"},
+      {[](SunFusionOptions& o) { o.evidence_forgetting = 1.0; }, "evidence_forgetting"},
+      {[](SunFusionOptions& o) { o.evidence_correlation = 0.5; }, "evidence_correlation"},
+      {[](SunFusionOptions& o) { o.max_correction_deg = -1.0; }, "max_correction_deg"},
+      {[](SunFusionOptions& o) { o.sun_bias_sigma_deg = 50.0; }, "sun_bias_sigma_deg"},
+      {[](SunFusionOptions& o) { o.sun_bias_length_frames = 0.0; }, "sun_bias_length_frames"},
+  };
+  for (const auto& [set, key] : cases) {
+    SunFusionOptions opt;
+    set(opt);
+    EXPECT_NE(opt.validate().toString().find(key), std::string::npos) << key;
+  }
 }
 
 }  // namespace
