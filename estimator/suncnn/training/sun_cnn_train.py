@@ -66,8 +66,8 @@ def targets(sun):
 def to_input(bgr_float, channels):
     """N,H,W,3 float in [0, 255] -> N,C,H,W normalised tensor (grey: BT.601 luma)."""
     x = bgr_float if channels == 3 else (bgr_float @ LUMA)[..., None]
-    x = torch.from_numpy(np.ascontiguousarray(x, dtype=np.float32)).permute(0, 3, 1, 2)
-    return (x / 255.0 - MEAN) / STD
+    x = torch.from_numpy(np.ascontiguousarray(x.transpose(0, 3, 1, 2), dtype=np.float32))
+    return x.mul_(1.0 / (255.0 * STD)).sub_(MEAN / STD)
 
 
 def plain(u8, channels):
@@ -91,25 +91,35 @@ def augment(u8, t, rng, channels, crop_min):
     flip = rng.random(n) < 0.5
     out[flip] = out[flip, :, ::-1]
     t[flip, 1] *= -1
-    x = out / 255.0
-    x = x * rng.uniform(0.75, 1.3, (n, 1, 1, 3)) * rng.uniform(0.5, 1.6, (n, 1, 1, 1))
-    x = np.clip(x, 0, 1) ** rng.uniform(0.6, 1.7, (n, 1, 1, 1))
+
+    def draw(lo, hi, shape):  # the random factors in float32, so that the batch stays float32
+        return rng.uniform(lo, hi, shape).astype(np.float32)
+
+    x = out * np.float32(1.0 / 255.0)
+    x *= draw(0.75, 1.3, (n, 1, 1, 3)) * draw(0.5, 1.6, (n, 1, 1, 1))
+    np.clip(x, 0, 1, out=x)
+    x **= draw(0.6, 1.7, (n, 1, 1, 1))
     m = x.mean((1, 2, 3), keepdims=True)
-    x = (x - m) * rng.uniform(0.6, 1.4, (n, 1, 1, 1)) + m
+    x -= m
+    x *= draw(0.6, 1.4, (n, 1, 1, 1))
+    x += m
     grey = (x @ LUMA)[..., None]
-    x = grey + (x - grey) * rng.uniform(0.0, 1.4, (n, 1, 1, 1))
-    x = x + rng.normal(0, 1, x.shape) * rng.uniform(0, 0.03, (n, 1, 1, 1))
+    x -= grey
+    x *= draw(0.0, 1.4, (n, 1, 1, 1))
+    x += grey
+    x += rng.standard_normal(x.shape, dtype=np.float32) * draw(0, 0.03, (n, 1, 1, 1))
     if channels == 3:  # 20 % grey, so that grey cameras can be fed to the colour model
         g = rng.random(n) < 0.2
         x[g] = (x[g] @ LUMA)[..., None]
-    x = np.clip(x, 0, 1) * 255.0
+    np.clip(x, 0, 1, out=x)
+    x *= np.float32(255.0)
     deg = rng.random(n) < 0.05
     for i in np.nonzero(deg)[0]:
         kind = rng.integers(3)
         x[i] = (rng.uniform(0, 12) if kind == 0 else rng.uniform(0, 255, 3)[None, None, :]
                 if kind == 1 else rng.uniform(0, 255, x[i].shape))
         t[i] = 0
-    return to_input(x.astype(np.float32), channels), torch.from_numpy(t), torch.from_numpy(
+    return to_input(x, channels), torch.from_numpy(t), torch.from_numpy(
         deg.astype(np.float32))
 
 
