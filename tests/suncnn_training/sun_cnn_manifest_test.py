@@ -8,6 +8,7 @@ train_sun_cnn.sh's --real path, on the 11 real KITTI 00 frames. Python only (no 
 import argparse
 import csv
 import hashlib
+import json
 import os
 import shutil
 import subprocess
@@ -246,6 +247,38 @@ class EndToEnd(Base):
         self.assertEqual(p.returncode, 0, p.stderr)
         set_name = os.path.basename(os.path.normpath(ARGS.frames))
         self.assertIn(f"| sun_cnn | {set_name} | 11 |", p.stdout)
+
+    def test_members_trained_apart_join_into_the_same_ensemble(self):
+        """Two members trained in two processes (--first-member, --save-members) and joined with
+        --load-members export the same model, byte for byte, as one process training both."""
+        if not ARGS.trainer:
+            self.skipTest("needs --trainer")
+        manifest, _ = self.manifest("--real", f"{ARGS.frames}:{ARGS.sun_csv}:train")
+
+        def train(tag, *extra):
+            out = os.path.join(self.work, tag)
+            os.makedirs(out)
+            p = subprocess.run([sys.executable, ARGS.trainer, "--manifest", manifest,
+                                "--out-dir", out, "--reference", os.path.join(out, "ref.txt"),
+                                "--epochs", "1", "--threads", "1", *extra],
+                               capture_output=True, text=True)
+            self.assertEqual(p.returncode, 0, p.stderr)
+            with open(os.path.join(out, "sun_cnn.onnx"), "rb") as f:
+                return f.read(), out
+
+        together, _ = train("together", "--members", "2")
+        pt = [os.path.join(self.work, f"m{k}.pt") for k in (0, 1)]
+        for k in (0, 1):
+            train(f"apart{k}", "--members", "1", "--first-member", str(k), "--save-members", pt[k])
+        joined, out = train("joined", "--load-members", *pt)
+        self.assertEqual(together, joined)
+        with open(os.path.join(out, "sun_cnn.json")) as f:
+            self.assertEqual(json.load(f)["mc"]["members"], 2)
+        p = subprocess.run([sys.executable, ARGS.trainer, "--manifest", manifest, "--out-dir",
+                            out, "--reference", os.path.join(out, "ref.txt"), "--epochs", "2",
+                            "--load-members", *pt], capture_output=True, text=True)
+        self.assertNotEqual(p.returncode, 0)
+        self.assertIn("--load-members", p.stderr)
 
 
 if __name__ == "__main__":

@@ -13,6 +13,11 @@ random crop (75-100 % of each side) resized to 208x64, horizontal flip (az -> -a
 balance, exposure, gamma, contrast, saturation, defocus blur, sensor noise, 20 % grey (colour
 model), and 5 % images without sun cues (black, flat colour, noise) with target 0.
 `--channels 1` trains the grey model (BT.601 luma of the same images) for grey cameras.
+
+Members can train in separate processes, one core each, and be joined afterwards; at the same
+thread count the joined ensemble is the one a single process trains, byte for byte:
+  sun_cnn_train.py ... --members 1 --first-member K --save-members mK.pt   (K = 0, 1, 2)
+  sun_cnn_train.py ... --load-members m0.pt m1.pt m2.pt                   (calibrate, export)
 """
 import argparse
 import csv
@@ -237,6 +242,14 @@ def main():
                     help="smallest random crop, share of each side")
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--seed", type=int, default=20261125)
+    ap.add_argument("--first-member", type=int, default=0,
+                    help="member m trains from seed + first_member + m (members trained in "
+                         "separate processes, then joined with --load-members)")
+    ap.add_argument("--save-members", metavar="PT",
+                    help="also write the trained members' weights (torch.save) to PT")
+    ap.add_argument("--load-members", metavar="PT", nargs="+",
+                    help="train nothing: take the members saved by --save-members runs, in "
+                         "order, and calibrate, report and export them as one ensemble")
     a = ap.parse_args()
     torch.set_num_threads(a.threads)
     torch.use_deterministic_algorithms(True)
@@ -251,8 +264,25 @@ def main():
     ttr, wtr = targets(sun_tr)
     log(f"loaded {sum(len(v[0]) for v in data.values())} images in {time.time() - t0:.0f} s")
     t_train = time.time()
-    members = [train_member(xtr, ttr, wtr, a, a.seed + m, log) for m in range(a.members)]
-    train_s = time.time() - t_train
+    if a.load_members:
+        saved = [torch.load(path) for path in a.load_members]
+        if any(s["channels"] != a.channels or s["epochs"] != a.epochs for s in saved):
+            raise SystemExit("--load-members: channels or epochs differ from this run's")
+        members = []
+        for s in saved:
+            for state in s["members"]:
+                members.append(SunCnn(a.channels, a.width, a.depth))
+                members[-1].load_state_dict(state)
+                members[-1].eval()
+        a.members = len(members)
+        train_s = sum(s["train_seconds"] for s in saved)
+    else:
+        members = [train_member(xtr, ttr, wtr, a, a.seed + a.first_member + m, log)
+                   for m in range(a.members)]
+        train_s = time.time() - t_train
+    if a.save_members:
+        torch.save({"members": [m.state_dict() for m in members], "channels": a.channels,
+                    "epochs": a.epochs, "train_seconds": train_s}, a.save_members)
 
     # Choices on the validation rows only: the validity threshold and the sigma scale
     # (sun_cnn_model.calibrate).
