@@ -211,6 +211,13 @@ Expected<std::string> renderDrive(const Scenario& s, const std::string& out_root
   Isometry3 T_c0_c1 = Isometry3::Identity();
   T_c0_c1.translation() = Eigen::Vector3d(s.camera.baseline_m, 0, 0);
   const TimeNs dt_ns = static_cast<TimeNs>(std::llround(1e9 / s.route.rate_hz));
+  // The city, the route and the POV-Ray scene live in the grid frame g (streets along x_g and
+  // y_g, z up); the grid lies on the ground turned by place.grid_heading_deg from east:
+  // T_enu_g = Rz(heading). The sun is turned into g for the lighting and the sky; everything
+  // written (poses, sun in the camera, body states, OXTS) is in ENU.
+  const double heading_rad = s.grid_heading_deg * kPi / 180.0;
+  Isometry3 T_enu_g = Isometry3::Identity();
+  T_enu_g.linear() = Eigen::AngleAxisd(heading_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   std::string ts, poses, poses_enu,
       sun_c_csv = "frame,sx,sy,sz\n", sun_enu_csv = "frame,zenith_deg,azimuth_deg,e,n,u\n",
       body_csv = "frame,utc_ns,e,n,u,roll_rad,pitch_rad,yaw_rad,ve,vn,vu\n",
@@ -236,9 +243,12 @@ Expected<std::string> renderDrive(const Scenario& s, const std::string& out_root
     const TimeNs t = s.start_utc + k * dt_ns;
     auto sp = sun::computeSolarPosition(t, spa);
     if (!sp) return sp.status();
-    const Isometry3 T_enu_c0 = vs.T_enu_b * T_b_c0;
+    const Isometry3& T_g_b = vs.T_enu_b;  // the route is generated in the grid frame
+    const Isometry3 T_g_c0 = T_g_b * T_b_c0;
+    const Isometry3 T_enu_c0 = T_enu_g * T_g_c0;
     const double drive_fraction = s.frames > 1 ? static_cast<double>(k) / (s.frames - 1) : 0.0;
-    const Isometry3 T_enu_c1 = T_enu_c0 * T_c0_c1 * rightCameraError(s.rig_error, drive_fraction);
+    const Isometry3 T_g_c1 = T_g_c0 * T_c0_c1 * rightCameraError(s.rig_error, drive_fraction);
+    const Eigen::Vector3d sun_g = T_enu_g.linear().transpose() * sp->sun_enu;
     if (k == 0) T_enu_c0_first = T_enu_c0;
     const int period = s.style.frames_per_look > 0 ? k / s.style.frames_per_look : 0;
     if (k == 0 || period != look_period) {
@@ -246,28 +256,28 @@ Expected<std::string> renderDrive(const Scenario& s, const std::string& out_root
       look_period = period;
     }
     frame_sensor.push_back(look.sensor);
-    FrameLighting fl = computeLighting(sp->sun_enu, look.sky, look.sensor.exposure_target);
+    FrameLighting fl = computeLighting(sun_g, look.sky, look.sensor.exposure_target);
     fl.pov.sun_rgb = fl.pov.sun_rgb.cwiseProduct(look.sun_tint);
     fl.pov.ambient_rgb = look.ambient_scale * fl.pov.ambient_rgb.cwiseProduct(look.sky_tint);
     fl.pov.materials = look.materials;
     char name[64];
     std::snprintf(name, sizeof name, "sky_%06d.hdr", k);
     fl.pov.sky_image = name;
-    const PerezSky sky(sp->sun_enu, look.sky);
+    const PerezSky sky(sun_g, look.sky);
     cv::Mat sky_img = sky.equirectangular(s.sky_image_width, s.sky_image_width / 2,
                                           fl.exposure_scale, Eigen::Vector3d(1500, 1500, 1500));
     if (s.style.seed != 0) {  // BGR channel order
       cv::multiply(sky_img, cv::Scalar(look.sky_tint.z(), look.sky_tint.y(), look.sky_tint.x()),
                    sky_img);
       styleSky(sky_img, look);
-      addSunGlow(sky_img, sp->sun_enu, look, look.sensor.exposure_target);
+      addSunGlow(sky_img, sun_g, look, look.sensor.exposure_target);
     }
     if (!cv::imwrite(pov_dir + "/" + name, sky_img))
       return ioError("cannot write sky image " + std::string(name));
     std::snprintf(name, sizeof name, "frame_%06d.pov", k);
-    SUNVO_RETURN_IF_ERROR(writeText(
-        pov_dir + "/" + name,
-        povFrame({s.camera, s.camera}, {T_enu_c0, T_enu_c1}, fl.pov, "city.inc", nullptr)));
+    SUNVO_RETURN_IF_ERROR(
+        writeText(pov_dir + "/" + name,
+                  povFrame({s.camera, s.camera}, {T_g_c0, T_g_c1}, fl.pov, "city.inc", nullptr)));
     for (int c = 0; c < 2; ++c) {
       RenderJob j;
       j.work_dir = pov_dir;
@@ -292,13 +302,15 @@ Expected<std::string> renderDrive(const Scenario& s, const std::string& out_root
     std::snprintf(buf, sizeof buf, "%d,%.6f,%.6f,%.6f,%.6f,%.6f\n", k, sp->zenith_deg,
                   sp->azimuth_deg, sp->sun_enu.x(), sp->sun_enu.y(), sp->sun_enu.z());
     sun_enu_csv += buf;
-    const Eigen::Vector3d p_imu = vs.T_enu_b * Eigen::Vector3d(0, 0, 0.93);
-    T_enu_imu_all.push_back(vs.T_enu_b * T_b_imu);
-    v_enu_all.push_back(vs.v_enu);
+    const Eigen::Vector3d p_imu = T_enu_g * T_g_b * Eigen::Vector3d(0, 0, 0.93);
+    T_enu_imu_all.push_back(T_enu_g * T_g_b * T_b_imu);
+    const Eigen::Vector3d v_enu = T_enu_g.linear() * vs.v_enu;
+    v_enu_all.push_back(v_enu);
+    const double yaw_enu = vs.yaw_rad + heading_rad;
     times_all.push_back(t);
     std::snprintf(buf, sizeof buf, "%d,%lld,%.4f,%.4f,%.4f,%.7f,%.7f,%.7f,%.4f,%.4f,%.4f\n", k,
                   static_cast<long long>(t), p_imu.x(), p_imu.y(), p_imu.z(), vs.roll_rad,
-                  vs.pitch_rad, vs.yaw_rad, vs.v_enu.x(), vs.v_enu.y(), vs.v_enu.z());
+                  vs.pitch_rad, yaw_enu, v_enu.x(), v_enu.y(), v_enu.z());
     body_csv += buf;
     {
       const Eigen::Vector3d err_deg = rightCameraErrorDeg(s.rig_error, drive_fraction);

@@ -85,6 +85,8 @@ Status Scenario::validate() const {
   if (!(longitude_deg >= -180 && longitude_deg <= 180))
     return range("place.longitude_deg", "[-180, 180]");
   if (!(altitude_m >= -500 && altitude_m <= 9000)) return range("place.altitude_m", "[-500, 9000]");
+  if (!(grid_heading_deg >= -180 && grid_heading_deg <= 180))
+    return range("place.grid_heading_deg", "[-180, 180]");
   if (!(frames >= 1 && frames <= 100000)) return range("frames", "[1, 100000]");
   if (!(sky_image_width >= 32 && sky_image_width <= 4096))
     return range("sky.image_width", "[32, 4096]");
@@ -125,10 +127,11 @@ Expected<Scenario> parseScenario(const std::string& text, const std::string& lab
       s.start_utc = *t;
     }
     const YAML::Node place = root["place"];
-    r.keys(place, "place", {"latitude_deg", "longitude_deg", "altitude_m"});
+    r.keys(place, "place", {"latitude_deg", "longitude_deg", "altitude_m", "grid_heading_deg"});
     r.get(place, "place", "latitude_deg", s.latitude_deg);
     r.get(place, "place", "longitude_deg", s.longitude_deg);
     r.get(place, "place", "altitude_m", s.altitude_m);
+    r.get(place, "place", "grid_heading_deg", s.grid_heading_deg);
     const YAML::Node sky = root["sky"];
     r.keys(sky, "sky", {"turbidity", "image_width"});
     r.get(sky, "sky", "turbidity", s.sky.turbidity);

@@ -67,8 +67,11 @@ struct Scenario {
   double latitude_deg = 49.0;  // ENU origin, WGS84, [-90, 90]
   double longitude_deg = 8.4;  // [-180, 180]
   double altitude_m = 115.0;   // [-500, 9000]
-  TimeNs start_utc = 0;        // first frame, UTC
-  int frames = 100;            // [1, 100000]
+  // The street grid's x axis on the ground, deg counter-clockwise from east, [-180, 180]:
+  // 0 puts the streets along east and north.
+  double grid_heading_deg = 0.0;
+  TimeNs start_utc = 0;  // first frame, UTC
+  int frames = 100;      // [1, 100000]
   std::uint64_t seed = 1;
   int sky_image_width = 256;  // equirectangular sky, px (height = width / 2), [32, 4096]
   SkyOptions sky;

@@ -1,0 +1,168 @@
+// renderDrive's grid heading (place.grid_heading_deg): the city, the route and the POV-Ray scene
+// turn together on the ground, the sun is turned into the grid for the lighting, and every file
+// written stays in ENU.
+#include "sunvo/render/drive.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace sunvo::render {
+namespace {
+
+constexpr double kPi = 3.141592653589793;
+
+std::string scenarioYaml(double heading_deg) {
+  char b[1024];
+  std::snprintf(b, sizeof b,
+                "name: grid_heading\n"
+                "drive_number: 7\n"
+                "place: {latitude_deg: 41.9, longitude_deg: 12.5, altitude_m: 20.0, "
+                "grid_heading_deg: %.1f}\n"
+                "start_utc: \"2026-07-14 07:40:00\"\n"
+                "frames: 2\n"
+                "seed: 11\n"
+                "sky: {image_width: 64}\n"
+                "city: {blocks_x: 3, blocks_y: 3}\n"
+                "route: {rate_hz: 1}\n"
+                "camera: {fu: 80.0, fv: 80.0, cu: 67.5, cv: 19.8, baseline_m: 0.537, width: 138, "
+                "height: 42}\n"
+                "render: {antialias_threshold: 0.0, quality: 4}\n",
+                heading_deg);
+  return b;
+}
+
+std::string readText(const std::string& path) {
+  std::ifstream f(path);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+// Rows of numbers of a CSV (header skipped) or of a KITTI pose file.
+std::vector<std::vector<double>> readRows(const std::string& path, bool header) {
+  std::ifstream f(path);
+  std::string line;
+  if (header) std::getline(f, line);
+  std::vector<std::vector<double>> rows;
+  while (std::getline(f, line)) {
+    for (char& c : line)
+      if (c == ',') c = ' ';
+    std::istringstream in(line);
+    std::vector<double> row;
+    for (double v; in >> v;) row.push_back(v);
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+// The sun direction of the frame's POV-Ray parallel light (location - point_at), back from
+// POV-Ray's <x, z, y> order into the scene's (x, y, z).
+Eigen::Vector3d povSun(const std::string& pov_file) {
+  const std::string text = readText(pov_file);
+  const auto at = text.find("light_source { <");
+  const auto to = text.find("point_at <", at);
+  Eigen::Vector3d loc, aim;
+  if (at == std::string::npos || to == std::string::npos ||
+      std::sscanf(text.c_str() + at, "light_source { <%lf,%lf,%lf>", &loc.x(), &loc.z(),
+                  &loc.y()) != 3 ||
+      std::sscanf(text.c_str() + to, "point_at <%lf,%lf,%lf>", &aim.x(), &aim.z(), &aim.y()) != 3) {
+    ADD_FAILURE() << pov_file << ": no parallel sun light";
+    return Eigen::Vector3d::Zero();
+  }
+  return (loc - aim).normalized();
+}
+
+std::string renderWithHeading(double heading_deg) {
+  auto s = parseScenario(scenarioYaml(heading_deg), "grid_heading");
+  EXPECT_TRUE(s) << s.status().toString();
+  if (!s) return {};
+  const auto out = std::filesystem::path(SUNVO_BINARY_DIR) / "test_render_cache" /
+                   ("grid_heading_" + std::to_string(static_cast<int>(heading_deg)));
+  std::filesystem::remove_all(out);
+  auto drive = renderDrive(*s, out.string(), 2, {});
+  EXPECT_TRUE(drive) << drive.status().toString();
+  return drive ? *drive : std::string();
+}
+
+TEST(Drive, GridHeadingTurnsTheCityOnTheGroundAndKeepsTheFilesInEnu) {
+  const double heading_deg = 90.0;
+  const std::string d0 = renderWithHeading(0.0), d1 = renderWithHeading(heading_deg);
+  ASSERT_FALSE(d0.empty());
+  ASSERT_FALSE(d1.empty());
+  const Eigen::Matrix3d R_enu_g =
+      Eigen::AngleAxisd(heading_deg * kPi / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+
+  // Same place and times: the same sun in ENU; the same route in the grid: the same motion.
+  EXPECT_EQ(readText(d0 + "/gt/sun_enu.csv"), readText(d1 + "/gt/sun_enu.csv"));
+  EXPECT_EQ(readText(d0 + "/gt/poses_cam0.txt"), readText(d1 + "/gt/poses_cam0.txt"));
+  const auto sun_enu = readRows(d0 + "/gt/sun_enu.csv", true);
+  const auto pose0 = readRows(d0 + "/gt/poses_cam0_enu.txt", false);
+  const auto pose1 = readRows(d1 + "/gt/poses_cam0_enu.txt", false);
+  const auto sun_c0 = readRows(d0 + "/gt/sun_cam0.csv", true);
+  const auto sun_c1 = readRows(d1 + "/gt/sun_cam0.csv", true);
+  const auto body0 = readRows(d0 + "/gt/body_enu.csv", true);
+  const auto body1 = readRows(d1 + "/gt/body_enu.csv", true);
+  ASSERT_EQ(pose0.size(), 2u);
+  ASSERT_EQ(pose1.size(), 2u);
+  ASSERT_EQ(sun_enu.size(), 2u);
+  for (std::size_t k = 0; k < 2; ++k) {
+    ASSERT_EQ(pose0[k].size(), 12u);
+    ASSERT_EQ(pose1[k].size(), 12u);
+    Eigen::Matrix3d R0, R1;
+    Eigen::Vector3d t0, t1;
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) {
+        R0(i, j) = pose0[k][4 * i + j];
+        R1(i, j) = pose1[k][4 * i + j];
+      }
+      t0(i) = pose0[k][4 * i + 3];
+      t1(i) = pose1[k][4 * i + 3];
+    }
+    // The camera's pose in ENU turns with the grid.
+    EXPECT_TRUE((R_enu_g * R0).isApprox(R1, 1e-6)) << k;
+    EXPECT_TRUE((R_enu_g * t0).isApprox(t1, 1e-6)) << k;
+    // The sun in the camera is the ENU sun seen from the turned camera: it moved.
+    const Eigen::Vector3d s_enu(sun_enu[k][3], sun_enu[k][4], sun_enu[k][5]);
+    const Eigen::Vector3d s_c0(sun_c0[k][1], sun_c0[k][2], sun_c0[k][3]);
+    const Eigen::Vector3d s_c1(sun_c1[k][1], sun_c1[k][2], sun_c1[k][3]);
+    EXPECT_LT((R0.transpose() * s_enu - s_c0).norm(), 1e-5) << k;
+    EXPECT_LT((R1.transpose() * s_enu - s_c1).norm(), 1e-5) << k;
+    EXPECT_GT((s_c1 - s_c0).norm(), 0.1) << k;
+    // The POV-Ray scene is the grid: its sun is the ENU sun turned back by the heading.
+    char pov[32];
+    std::snprintf(pov, sizeof pov, "/pov/frame_%06zu.pov", k);
+    EXPECT_LT((povSun(d0 + pov) - s_enu).norm(), 1e-6) << k;
+    EXPECT_LT((povSun(d1 + pov) - R_enu_g.transpose() * s_enu).norm(), 1e-6) << k;
+    // Body states: position and velocity turned, yaw (column 7) plus the heading.
+    ASSERT_EQ(body1[k].size(), 11u);
+    const Eigen::Vector3d p0(body0[k][2], body0[k][3], body0[k][4]);
+    const Eigen::Vector3d p1(body1[k][2], body1[k][3], body1[k][4]);
+    const Eigen::Vector3d v0(body0[k][8], body0[k][9], body0[k][10]);
+    const Eigen::Vector3d v1(body1[k][8], body1[k][9], body1[k][10]);
+    EXPECT_LT((R_enu_g * p0 - p1).norm(), 1e-3) << k;
+    EXPECT_LT((R_enu_g * v0 - v1).norm(), 1e-3) << k;
+    EXPECT_NEAR(body1[k][7] - body0[k][7], heading_deg * kPi / 180.0, 1e-6) << k;
+  }
+  // The camera images differ: the sun falls on the streets from another side.
+  for (const char* image : {"/image_02/data/0000000000.png", "/image_00/data/0000000001.png"}) {
+    EXPECT_NE(readText(d0 + image), readText(d1 + image)) << image;
+  }
+}
+
+TEST(Drive, GridHeadingIsRangeChecked) {
+  auto s = parseScenario(scenarioYaml(190.0), "grid_heading");
+  ASSERT_FALSE(s);
+  EXPECT_NE(s.status().message().find("place.grid_heading_deg"), std::string::npos)
+      << s.status().toString();
+}
+
+}  // namespace
+}  // namespace sunvo::render
