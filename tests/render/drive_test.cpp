@@ -19,7 +19,7 @@ namespace {
 
 constexpr double kPi = 3.141592653589793;
 
-std::string scenarioYaml(double heading_deg) {
+std::string scenarioYaml(double heading_deg, int traffic_cars = 0) {
   char b[1024];
   std::snprintf(b, sizeof b,
                 "name: grid_heading\n"
@@ -34,8 +34,9 @@ std::string scenarioYaml(double heading_deg) {
                 "route: {rate_hz: 1}\n"
                 "camera: {fu: 80.0, fv: 80.0, cu: 67.5, cv: 19.8, baseline_m: 0.537, width: 138, "
                 "height: 42}\n"
-                "render: {antialias_threshold: 0.0, quality: 4}\n",
-                heading_deg);
+                "render: {antialias_threshold: 0.0, quality: 4}\n"
+                "traffic: {cars: %d}\n",
+                heading_deg, traffic_cars);
   return b;
 }
 
@@ -80,12 +81,14 @@ Eigen::Vector3d povSun(const std::string& pov_file) {
   return (loc - aim).normalized();
 }
 
-std::string renderWithHeading(double heading_deg) {
-  auto s = parseScenario(scenarioYaml(heading_deg), "grid_heading");
+// Renders into test_render_cache/<test>_<heading>_<cars>: each test its own folders (ctest -j).
+std::string renderWithHeading(const std::string& test, double heading_deg, int traffic_cars) {
+  auto s = parseScenario(scenarioYaml(heading_deg, traffic_cars), "grid_heading");
   EXPECT_TRUE(s) << s.status().toString();
   if (!s) return {};
   const auto out = std::filesystem::path(SUNVO_BINARY_DIR) / "test_render_cache" /
-                   ("grid_heading_" + std::to_string(static_cast<int>(heading_deg)));
+                   (test + "_" + std::to_string(static_cast<int>(heading_deg)) + "_" +
+                    std::to_string(traffic_cars));
   std::filesystem::remove_all(out);
   auto drive = renderDrive(*s, out.string(), 2, {});
   EXPECT_TRUE(drive) << drive.status().toString();
@@ -94,7 +97,8 @@ std::string renderWithHeading(double heading_deg) {
 
 TEST(Drive, GridHeadingTurnsTheCityOnTheGroundAndKeepsTheFilesInEnu) {
   const double heading_deg = 90.0;
-  const std::string d0 = renderWithHeading(0.0), d1 = renderWithHeading(heading_deg);
+  const std::string d0 = renderWithHeading("grid_heading", 0.0, 0),
+                    d1 = renderWithHeading("grid_heading", heading_deg, 0);
   ASSERT_FALSE(d0.empty());
   ASSERT_FALSE(d1.empty());
   const Eigen::Matrix3d R_enu_g =
@@ -155,6 +159,36 @@ TEST(Drive, GridHeadingTurnsTheCityOnTheGroundAndKeepsTheFilesInEnu) {
   for (const char* image : {"/image_02/data/0000000000.png", "/image_00/data/0000000001.png"}) {
     EXPECT_NE(readText(d0 + image), readText(d1 + image)) << image;
   }
+}
+
+std::size_t count(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+// Moving cars (traffic.hpp) are drawn into each frame's scene, move between frames and change
+// nothing but the images.
+TEST(Drive, TrafficAddsMovingCarsToEveryFrameAndNothingElse) {
+  const std::string d0 = renderWithHeading("traffic", 0.0, 0),
+                    d1 = renderWithHeading("traffic", 0.0, 60);
+  ASSERT_FALSE(d0.empty());
+  ASSERT_FALSE(d1.empty());
+  for (const char* gt : {"/gt/poses_cam0_enu.txt", "/gt/sun_cam0.csv", "/gt/body_enu.csv"}) {
+    EXPECT_EQ(readText(d0 + gt), readText(d1 + gt)) << gt;
+  }
+  const std::string a0 = readText(d0 + "/pov/frame_000000.pov");
+  const std::string f0 = readText(d1 + "/pov/frame_000000.pov");
+  const std::string f1 = readText(d1 + "/pov/frame_000001.pov");
+  EXPECT_EQ(count(a0, "box {"), 0u);  // the static city is in city.inc
+  const std::size_t boxes = count(f0, "box {");
+  EXPECT_EQ(boxes % 3, 0u);  // body, cabin, tyres per car
+  EXPECT_GT(boxes, 3u * 30);
+  EXPECT_LE(boxes, 3u * 60);
+  // The same cars one frame (1 s) later are elsewhere.
+  EXPECT_NE(f0.substr(f0.find("box {")), f1.substr(f1.find("box {")));
+  EXPECT_NE(readText(d0 + "/image_02/data/0000000001.png"),
+            readText(d1 + "/image_02/data/0000000001.png"));
 }
 
 TEST(Drive, GridHeadingIsRangeChecked) {

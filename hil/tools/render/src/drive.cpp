@@ -187,6 +187,7 @@ Expected<std::string> renderDrive(const Scenario& s, const std::string& out_root
   const City city = generateCity(drive_look.city, s.seed, drive_look.city_look);
   auto route = generateRoute(city, s.route, s.frames, s.seed);
   if (!route) return route.status();
+  const std::vector<MovingCar> traffic = generateTraffic(city, s.traffic, s.seed);
   const std::string iso = formatUtcIso(s.start_utc);
   const std::string date = iso.substr(0, 4) + "_" + iso.substr(5, 2) + "_" + iso.substr(8, 2);
   char drive_name[64];
@@ -277,7 +278,9 @@ Expected<std::string> renderDrive(const Scenario& s, const std::string& out_root
     std::snprintf(name, sizeof name, "frame_%06d.pov", k);
     SUNVO_RETURN_IF_ERROR(
         writeText(pov_dir + "/" + name,
-                  povFrame({s.camera, s.camera}, {T_g_c0, T_g_c1}, fl.pov, "city.inc", nullptr)));
+                  povFrame({s.camera, s.camera}, {T_g_c0, T_g_c1}, fl.pov, "city.inc", nullptr) +
+                      povPrimitives(trafficAt(traffic, vs.t_s, T_g_b.translation().head<2>(),
+                                              s.traffic, drive_look.city_look))));
     for (int c = 0; c < 2; ++c) {
       RenderJob j;
       j.work_dir = pov_dir;

@@ -41,8 +41,13 @@ std::string povCamera(const StereoCamera& cam, const Isometry3& T_enu_c) {
 std::string povSceneBody(const Scene& scene) {
   std::string s = scene.declarations;
   s += "plane { y, 0 texture { " + scene.ground_texture + " } }\n";
-  s.reserve(s.size() + scene.primitives.size() * 200);
-  for (const Primitive& p : scene.primitives) {
+  return s + povPrimitives(scene.primitives);
+}
+
+std::string povPrimitives(const std::vector<Primitive>& primitives) {
+  std::string s;
+  s.reserve(primitives.size() * 200);
+  for (const Primitive& p : primitives) {
     const bool named = p.texture.find(' ') == std::string::npos;
     const std::string tex =
         named ? "texture { " + p.texture + " }" : "texture { " + p.texture + " }";

@@ -93,6 +93,7 @@ Status Scenario::validate() const {
   SUNVO_RETURN_IF_ERROR(sky.validate());
   SUNVO_RETURN_IF_ERROR(city.validate());
   SUNVO_RETURN_IF_ERROR(route.validate());
+  SUNVO_RETURN_IF_ERROR(traffic.validate());
   if (auto st = camera.validate(); !st.isOk()) return invalidArgument("camera: " + st.message());
   SUNVO_RETURN_IF_ERROR(quality.validate());
   SUNVO_RETURN_IF_ERROR(sensor.validate());
@@ -114,7 +115,7 @@ Expected<Scenario> parseScenario(const std::string& text, const std::string& lab
   try {
     r.keys(root, "",
            {"name", "drive_number", "place", "start_utc", "frames", "seed", "sky", "city", "route",
-            "camera", "render", "sensor", "calib_error", "style", "rig_error"});
+            "traffic", "camera", "render", "sensor", "calib_error", "style", "rig_error"});
     r.get(root, "", "name", s.name);
     r.get(root, "", "drive_number", s.drive_number);
     r.get(root, "", "frames", s.frames);
@@ -170,6 +171,14 @@ Expected<Scenario> parseScenario(const std::string& text, const std::string& lab
     r.get(ro, "route", "roll_amplitude_deg", s.route.roll_amplitude_deg);
     r.get(ro, "route", "roll_per_lateral_accel_deg", s.route.roll_per_lateral_accel_deg);
     r.get(ro, "route", "pitch_per_long_accel_deg", s.route.pitch_per_long_accel_deg);
+    const YAML::Node tr = root["traffic"];
+    r.keys(tr, "traffic",
+           {"cars", "speed_min_mps", "speed_max_mps", "lane_offset_m", "clearance_m"});
+    r.get(tr, "traffic", "cars", s.traffic.cars);
+    r.get(tr, "traffic", "speed_min_mps", s.traffic.speed_min_mps);
+    r.get(tr, "traffic", "speed_max_mps", s.traffic.speed_max_mps);
+    r.get(tr, "traffic", "lane_offset_m", s.traffic.lane_offset_m);
+    r.get(tr, "traffic", "clearance_m", s.traffic.clearance_m);
     const YAML::Node cam = root["camera"];
     r.keys(cam, "camera", {"fu", "fv", "cu", "cv", "baseline_m", "width", "height"});
     r.get(cam, "camera", "fu", s.camera.fu);

@@ -26,6 +26,7 @@
 #include "sunvo/render/scene.hpp"
 #include "sunvo/render/sensor.hpp"
 #include "sunvo/render/style.hpp"
+#include "sunvo/render/traffic.hpp"
 
 namespace sunvo::render {
 
@@ -77,6 +78,7 @@ struct Scenario {
   SkyOptions sky;
   CityOptions city;
   RouteOptions route;
+  TrafficOptions traffic;  // moving cars (traffic.hpp); none by default
   StereoCamera camera{721.5377, 721.5377, 609.5593, 172.854, 0.537, 1242, 375};
   RenderQuality quality;
   SensorOptions sensor;

@@ -42,6 +42,8 @@ struct Lighting {
 
 // The scene part (declarations, ground plane and primitives) as POV-Ray text.
 std::string povSceneBody(const Scene& scene);
+// Primitives alone as POV-Ray text (a frame's moving objects, after the static scene).
+std::string povPrimitives(const std::vector<Primitive>& primitives);
 
 // A complete frame: global settings, lighting and sky, `#include "include_file"` when
 // include_file is non-empty (else the scene body inline), and one camera per pose selected by
