@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <string>
 
 #include "sunvo/render/drive.hpp"
@@ -23,6 +24,46 @@ TEST(City, DeterministicForASeedAndDifferentAcrossSeeds) {
   EXPECT_EQ(a, b);
   EXPECT_NE(a, c);
   EXPECT_GT(generateCity(o, 11).scene.primitives.size(), 200u);
+}
+
+// Low-texture stretches: a plain block has only plain walls and ground, no street furniture, and
+// bare road up to the centre lines around it; with probability 0 nothing plain is drawn.
+TEST(City, PlainBlocksAreLowTextureStretches) {
+  CityOptions o;
+  o.blocks_x = 4;
+  o.blocks_y = 4;
+  auto textures = [](const City& c) {
+    std::map<std::string, int> n;
+    for (const Primitive& p : c.scene.primitives) ++n[p.texture.substr(0, 7)];
+    return n;
+  };
+  const City none = generateCity(o, 11);
+  EXPECT_EQ(none.scene.declarations.find("T_plain"), std::string::npos);
+  EXPECT_EQ(textures(none).count("T_plain"), 0u);
+  o.plain_block_probability = 1.0;
+  const City all = generateCity(o, 11);
+  const auto n = textures(all);
+  EXPECT_NE(all.scene.declarations.find("#declare T_plain_wall"), std::string::npos);
+  EXPECT_EQ(n.count("T_pole"), 0u);
+  EXPECT_EQ(n.count("T_trunk"), 0u);
+  EXPECT_EQ(n.count("T_mark"), 1u);  // the centre-line dashes stay, under the bare road
+  int road = 0, walls = 0;
+  for (const Primitive& p : all.scene.primitives) {
+    if (p.texture == "T_plain_road") {
+      ++road;
+      EXPECT_NEAR(p.b.x() - p.a.x(), all.pitch_m, 1e-9);  // centre line to centre line
+      EXPECT_GT(p.b.z(), 0.005);                          // above the dashes' top
+    }
+    walls += p.texture == "T_plain_wall";
+  }
+  EXPECT_EQ(road, 16);
+  EXPECT_GT(walls, 16 * 4);
+  o.plain_block_probability = 0.3;
+  const auto some = textures(generateCity(o, 11));
+  EXPECT_GT(some.count("T_plain"), 0u);
+  EXPECT_GT(some.count("T_pole"), 0u);
+  o.plain_block_probability = 1.5;
+  EXPECT_NE(o.validate().message().find("city.plain_block_probability"), std::string::npos);
 }
 
 TEST(Route, DeterministicSpeedsHeightAndTurns) {

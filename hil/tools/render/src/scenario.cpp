@@ -141,7 +141,7 @@ Expected<Scenario> parseScenario(const std::string& text, const std::string& lab
     r.keys(c, "city",
            {"blocks_x", "blocks_y", "block_size_m", "street_width_m", "sidewalk_width_m",
             "min_height_m", "max_height_m", "min_lot_m", "max_lot_m", "pole_spacing_m",
-            "tree_probability", "parked_car_probability"});
+            "tree_probability", "parked_car_probability", "plain_block_probability"});
     r.get(c, "city", "blocks_x", s.city.blocks_x);
     r.get(c, "city", "blocks_y", s.city.blocks_y);
     r.get(c, "city", "block_size_m", s.city.block_size_m);
@@ -154,6 +154,7 @@ Expected<Scenario> parseScenario(const std::string& text, const std::string& lab
     r.get(c, "city", "pole_spacing_m", s.city.pole_spacing_m);
     r.get(c, "city", "tree_probability", s.city.tree_probability);
     r.get(c, "city", "parked_car_probability", s.city.parked_car_probability);
+    r.get(c, "city", "plain_block_probability", s.city.plain_block_probability);
     const YAML::Node ro = root["route"];
     r.keys(ro, "route",
            {"speed_min_mps", "speed_max_mps", "max_lateral_accel_mps2", "max_long_accel_mps2",

@@ -42,6 +42,32 @@ const char* kDeclarations =
 #declare T_glass = texture { pigment { rgb <0.10,0.13,0.16> } }
 )";
 
+// Plain surfaces of the low-texture stretches (CityOptions::plain_block_probability), declared in
+// the city itself so that the classic and the styled looks both have them.
+const char* kPlainDeclarations =
+    "#declare T_plain_wall = texture { pigment { rgb 0.55 } }\n"
+    "#declare T_plain_ground = texture { pigment { rgb 0.42 } }\n"
+    "#declare T_plain_road = texture { pigment { rgb 0.16 } }\n";
+
+// A plain block's buildings: the same lots and heights as any block, walls without windows.
+template <typename Uni>
+void addPlainBuildings(Scene& sc, const CityOptions& o, double x0, double y0, double x1, double y1,
+                       Uni& uni) {
+  const double sw = o.sidewalk_width_m;
+  for (int row = 0; row < 2; ++row) {
+    const double ya = row == 0 ? y0 + sw : 0.5 * (y0 + y1);
+    const double yb = row == 0 ? 0.5 * (y0 + y1) : y1 - sw;
+    double x = x0 + sw;
+    while (x < x1 - sw - 1e-6) {
+      double w = uni(o.min_lot_m, o.max_lot_m);
+      if (x1 - sw - (x + w) < o.min_lot_m) w = x1 - sw - x;
+      sc.primitives.push_back(
+          box({x, ya, 0.0}, {x + w, yb, uni(o.min_height_m, o.max_height_m)}, "T_plain_wall"));
+      x += w;
+    }
+  }
+}
+
 const char* kAsphalt =
     "pigment { granite scale 0.15 color_map { [0 rgb 0.10] [0.5 rgb 0.17] [1 rgb 0.23] } } "
     "normal { granite 0.15 scale 0.03 }";
@@ -161,6 +187,8 @@ Status CityOptions::validate() const {
     return range("city.tree_probability", "[0, 1]");
   if (!(parked_car_probability >= 0 && parked_car_probability <= 1))
     return range("city.parked_car_probability", "[0, 1]");
+  if (!(plain_block_probability >= 0 && plain_block_probability <= 1))
+    return range("city.plain_block_probability", "[0, 1]");
   return Status::ok();
 }
 
@@ -188,6 +216,16 @@ City generateCity(const CityOptions& o, std::uint64_t seed, const CityLook& look
     for (int bj = 0; bj < o.blocks_y; ++bj) {
       const double x0 = bi * P + hw, y0 = bj * P + hw;  // block corner (incl. sidewalk)
       const double x1 = x0 + B, y1 = y0 + B;
+      const bool plain = o.plain_block_probability > 0 && U(rng) < o.plain_block_probability;
+      if (plain) {  // a low-texture stretch: plain block, bare half-streets around it
+        if (sc.declarations.find(kPlainDeclarations) == std::string::npos)
+          sc.declarations += kPlainDeclarations;
+        sc.primitives.push_back(
+            box({bi * P, bj * P, 0.001}, {(bi + 1) * P, (bj + 1) * P, 0.006}, "T_plain_road"));
+        sc.primitives.push_back(box({x0, y0, 0.0}, {x1, y1, 0.15}, "T_plain_ground"));
+        addPlainBuildings(sc, o, x0, y0, x1, y1, uni);
+        continue;
+      }
       sc.primitives.push_back(
           box({x0, y0, 0.0}, {x1, y1, 0.15}, U(rng) < 0.5 ? "T_sidewalk" : "T_sidewalk2"));
       const double sw = o.sidewalk_width_m;

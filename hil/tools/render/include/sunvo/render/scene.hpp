@@ -43,6 +43,10 @@ struct CityOptions {
   double pole_spacing_m = 25.0;          // street lamps along each sidewalk, m, [5, 200]
   double tree_probability = 0.5;         // chance of a tree per 12 m sidewalk slot, [0, 1]
   double parked_car_probability = 0.35;  // chance per 7 m curb slot, [0, 1]
+  // Low-texture stretches: the share of blocks built of plain, untextured surfaces (walls without
+  // windows, bare sidewalks, no street furniture) whose surrounding half-streets are bare road
+  // without marks, [0, 1]. 0 (the default) draws nothing from the seed for it.
+  double plain_block_probability = 0.0;
   Status validate() const;
 };
 
