@@ -49,10 +49,12 @@ const char* kPlainDeclarations =
     "#declare T_plain_ground = texture { pigment { rgb 0.42 } }\n"
     "#declare T_plain_road = texture { pigment { rgb 0.16 } }\n";
 
-// A plain block's buildings: the same lots and heights as any block, walls without windows.
-template <typename Uni>
-void addPlainBuildings(Scene& sc, const CityOptions& o, double x0, double y0, double x1, double y1,
-                       Uni& uni) {
+// The buildings of the block (x0, y0)-(x1, y1) (sidewalks included): two rows (south half, north
+// half) of lots along x, each lot's width and then its height drawn from uni, and then
+// texture() (which may draw too) names its texture.
+template <typename Uni, typename Texture>
+void addBuildings(Scene& sc, const CityOptions& o, double x0, double y0, double x1, double y1,
+                  Uni& uni, Texture&& texture) {
   const double sw = o.sidewalk_width_m;
   for (int row = 0; row < 2; ++row) {
     const double ya = row == 0 ? y0 + sw : 0.5 * (y0 + y1);
@@ -61,8 +63,8 @@ void addPlainBuildings(Scene& sc, const CityOptions& o, double x0, double y0, do
     while (x < x1 - sw - 1e-6) {
       double w = uni(o.min_lot_m, o.max_lot_m);
       if (x1 - sw - (x + w) < o.min_lot_m) w = x1 - sw - x;
-      sc.primitives.push_back(
-          box({x, ya, 0.0}, {x + w, yb, uni(o.min_height_m, o.max_height_m)}, "T_plain_wall"));
+      const double h = uni(o.min_height_m, o.max_height_m);
+      sc.primitives.push_back(box({x, ya, 0.0}, {x + w, yb, h}, texture()));
       x += w;
     }
   }
@@ -223,41 +225,25 @@ City generateCity(const CityOptions& o, std::uint64_t seed, const CityLook& look
         sc.primitives.push_back(
             box({bi * P, bj * P, 0.001}, {(bi + 1) * P, (bj + 1) * P, 0.006}, "T_plain_road"));
         sc.primitives.push_back(box({x0, y0, 0.0}, {x1, y1, 0.15}, "T_plain_ground"));
-        addPlainBuildings(sc, o, x0, y0, x1, y1, uni);
+        addBuildings(sc, o, x0, y0, x1, y1, uni, [] { return std::string("T_plain_wall"); });
         continue;
       }
       sc.primitives.push_back(
           box({x0, y0, 0.0}, {x1, y1, 0.15}, U(rng) < 0.5 ? "T_sidewalk" : "T_sidewalk2"));
-      const double sw = o.sidewalk_width_m;
-      // Two rows of buildings (south half, north half), lots along x.
-      for (int row = 0; row < 2; ++row) {
-        const double ya = row == 0 ? y0 + sw : 0.5 * (y0 + y1);
-        const double yb = row == 0 ? 0.5 * (y0 + y1) : y1 - sw;
-        double x = x0 + sw;
-        while (x < x1 - sw - 1e-6) {
-          double w = uni(o.min_lot_m, o.max_lot_m);
-          if (x1 - sw - (x + w) < o.min_lot_m) w = x1 - sw - x;
-          const double h = uni(o.min_height_m, o.max_height_m);
-          if (look.styled) {
-            const std::string tex = "F" + std::to_string(rng() % kStyleFacades);
-            sc.primitives.push_back(box({x, ya, 0.0}, {x + w, yb, h}, tex));
-            x += w;
-            continue;
-          }
-          const auto& c = kWall[static_cast<std::size_t>(rng() % kWall.size())];
-          const double s = uni(0.85, 1.1);
-          char tex[512];
-          std::snprintf(tex, sizeof tex,
-                        "pigment { function { %s(x,y,z) } pigment_map { [0 granite scale %.2f "
-                        "color_map { [0 %s] [1 %s] }] [1 rgb <%.3f,%.3f,%.3f>] } }",
-                        kWin[rng() % 3], uni(0.3, 1.5),
-                        rgb(c[0] * s * 0.8, c[1] * s * 0.8, c[2] * s * 0.8).c_str(),
-                        rgb(c[0] * s, c[1] * s, c[2] * s).c_str(), uni(0.06, 0.14), uni(0.08, 0.16),
-                        uni(0.10, 0.2));
-          sc.primitives.push_back(box({x, ya, 0.0}, {x + w, yb, h}, tex));
-          x += w;
-        }
-      }
+      addBuildings(sc, o, x0, y0, x1, y1, uni, [&] {
+        if (look.styled) return std::string("F").append(std::to_string(rng() % kStyleFacades));
+        const auto& c = kWall[static_cast<std::size_t>(rng() % kWall.size())];
+        const double s = uni(0.85, 1.1);
+        char tex[512];
+        std::snprintf(tex, sizeof tex,
+                      "pigment { function { %s(x,y,z) } pigment_map { [0 granite scale %.2f "
+                      "color_map { [0 %s] [1 %s] }] [1 rgb <%.3f,%.3f,%.3f>] } }",
+                      kWin[rng() % 3], uni(0.3, 1.5),
+                      rgb(c[0] * s * 0.8, c[1] * s * 0.8, c[2] * s * 0.8).c_str(),
+                      rgb(c[0] * s, c[1] * s, c[2] * s).c_str(), uni(0.06, 0.14), uni(0.08, 0.16),
+                      uni(0.10, 0.2));
+        return std::string(tex);
+      });
       // Street furniture along the four sidewalks: poles, trees (curb side), parked cars.
       for (int side = 0; side < 4; ++side) {
         // Curb line running from a to b, with the street on the outward side `out`.
