@@ -93,7 +93,8 @@ struct RouteOptions {
 
 // Vehicle body frame b: x forward, y left, z up, origin on the ground below the IMU.
 // R_enu_b = Rz(yaw) Ry(-pitch) Rx(roll): yaw from east counter-clockwise, pitch nose-up positive,
-// roll right-side-down positive.
+// roll right-side-down positive. "enu" here is the city's own frame: renderDrive turns it into
+// true ENU by place.grid_heading_deg (the same when that is 0).
 struct VehicleState {
   double t_s = 0.0;                                 // since the first frame
   Isometry3 T_enu_b;                                // pose
