@@ -231,6 +231,12 @@ TEST(Scenario, DriftBenchmarkTwinsDifferOnlyInTheRigAndAreLongerThanThreeKilomet
             3000.0);
 }
 
+TEST(Scenario, BusyShortDriftTwinsDifferOnlyInTheRig) {
+  EXPECT_GT(twinRouteLength("bench_drift_short_aa_busy_miscalibrated.yaml",
+                            "bench_drift_short_aa_busy_calibrated.yaml"),
+            250.0);
+}
+
 TEST(Scenario, ShortDriftTwinsDifferOnlyInTheRig) {
   EXPECT_GT(
       twinRouteLength("bench_drift_short_miscalibrated.yaml", "bench_drift_short_calibrated.yaml"),
