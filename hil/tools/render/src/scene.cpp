@@ -143,31 +143,50 @@ void addSidewalkExtras(Scene& sc, const CityLook& look, const Eigen::Vector2d& a
   }
 }
 
-// A styled parked car: a sedan (body and glass cabin, as the classic one) or a van (one tall
-// body with a glass band); its paint is one of the declared T_car textures.
+// Half extents on the ground of a car whose length runs along the unit street axis `along`.
+Eigen::Vector2d carHalfExtents(const Eigen::Vector2d& along, double half_length,
+                               double half_width) {
+  const Eigen::Vector2d across(-along.y(), along.x());
+  return along.cwiseAbs() * half_length + across.cwiseAbs() * half_width;
+}
+
+// The dark band between a car's body and the ground.
+Primitive tyreBand(const Eigen::Vector2d& c, const Eigen::Vector2d& half, const std::string& tyre) {
+  return box({c.x() - half.x() + 0.4, c.y() - half.y() + 0.1, 0.0},
+             {c.x() + half.x() - 0.4, c.y() + half.y() - 0.1, 0.25}, tyre);
+}
+
+// A styled parked car: a sedan (as the classic one) or a van (one tall body with a glass band);
+// its paint is one of the declared T_car textures.
 void addStyledCar(Scene& sc, CityLook::Car shape, const Eigen::Vector2d& c,
-                  const Eigen::Vector2d& half, const Eigen::Vector2d& half_cab,
-                  std::mt19937_64& rng) {
+                  const Eigen::Vector2d& along, std::mt19937_64& rng) {
   const std::string paint = "T_car" + std::to_string(rng() % kStyleCars);
   if (shape == CityLook::Car::kSedan) {
-    sc.primitives.push_back(box({c.x() - half.x(), c.y() - half.y(), 0.25},
-                                {c.x() + half.x(), c.y() + half.y(), 0.95}, paint));
-    sc.primitives.push_back(box({c.x() - half_cab.x(), c.y() - half_cab.y(), 0.95},
-                                {c.x() + half_cab.x(), c.y() + half_cab.y(), 1.45}, "T_glass"));
-  } else {
-    sc.primitives.push_back(box({c.x() - half.x(), c.y() - half.y(), 0.25},
-                                {c.x() + half.x(), c.y() + half.y(), 1.5}, paint));
-    sc.primitives.push_back(box({c.x() - half.x() - 0.01, c.y() - half.y() - 0.01, 1.5},
-                                {c.x() + half.x() + 0.01, c.y() + half.y() + 0.01, 2.0},
-                                "T_glass"));
-    sc.primitives.push_back(box({c.x() - half.x(), c.y() - half.y(), 2.0},
-                                {c.x() + half.x(), c.y() + half.y(), 2.2}, paint));
+    addSedan(sc.primitives, c, along, paint, "T_tyre");
+    return;
   }
-  sc.primitives.push_back(box({c.x() - half.x() + 0.4, c.y() - half.y() + 0.1, 0.0},
-                              {c.x() + half.x() - 0.4, c.y() + half.y() - 0.1, 0.25}, "T_tyre"));
+  const Eigen::Vector2d half = carHalfExtents(along, 2.1, 0.9);
+  sc.primitives.push_back(box({c.x() - half.x(), c.y() - half.y(), 0.25},
+                              {c.x() + half.x(), c.y() + half.y(), 1.5}, paint));
+  sc.primitives.push_back(box({c.x() - half.x() - 0.01, c.y() - half.y() - 0.01, 1.5},
+                              {c.x() + half.x() + 0.01, c.y() + half.y() + 0.01, 2.0}, "T_glass"));
+  sc.primitives.push_back(box({c.x() - half.x(), c.y() - half.y(), 2.0},
+                              {c.x() + half.x(), c.y() + half.y(), 2.2}, paint));
+  sc.primitives.push_back(tyreBand(c, half, "T_tyre"));
 }
 
 }  // namespace
+
+void addSedan(std::vector<Primitive>& out, const Eigen::Vector2d& c, const Eigen::Vector2d& along,
+              const std::string& paint, const std::string& tyre) {
+  const Eigen::Vector2d half = carHalfExtents(along, 2.1, 0.9);
+  const Eigen::Vector2d half_cab = carHalfExtents(along, 1.1, 0.8);
+  out.push_back(box({c.x() - half.x(), c.y() - half.y(), 0.25},
+                    {c.x() + half.x(), c.y() + half.y(), 0.95}, paint));
+  out.push_back(box({c.x() - half_cab.x(), c.y() - half_cab.y(), 0.95},
+                    {c.x() + half_cab.x(), c.y() + half_cab.y(), 1.45}, "T_glass"));
+  out.push_back(tyreBand(c, half, tyre));
+}
 
 Status CityOptions::validate() const {
   if (!(blocks_x >= 1 && blocks_x <= 60)) return range("city.blocks_x", "[1, 60]");
@@ -303,22 +322,13 @@ City generateCity(const CityOptions& o, std::uint64_t seed, const CityLook& look
         for (double s = 12.0; s < L - 12.0; s += 7.0) {
           if (U(rng) >= o.parked_car_probability) continue;
           const Eigen::Vector2d c = a + t * (s + uni(-0.5, 0.5)) + out * 1.1;
-          const Eigen::Vector2d half = t.cwiseAbs() * 2.1 + out.cwiseAbs() * 0.9;
-          const Eigen::Vector2d half_cab = t.cwiseAbs() * 1.1 + out.cwiseAbs() * 0.8;
           if (look.styled) {
-            addStyledCar(sc, look.car, c, half, half_cab, rng);
+            addStyledCar(sc, look.car, c, t, rng);
             continue;
           }
           const auto col = rgb(uni(0.05, 0.8), uni(0.05, 0.8), uni(0.05, 0.8));
-          const std::string tex = "pigment { " + col + " } finish { specular 0.3 }";
-          sc.primitives.push_back(box({c.x() - half.x(), c.y() - half.y(), 0.25},
-                                      {c.x() + half.x(), c.y() + half.y(), 0.95}, tex));
-          sc.primitives.push_back(box({c.x() - half_cab.x(), c.y() - half_cab.y(), 0.95},
-                                      {c.x() + half_cab.x(), c.y() + half_cab.y(), 1.45},
-                                      "T_glass"));
-          sc.primitives.push_back(box({c.x() - half.x() + 0.4, c.y() - half.y() + 0.1, 0.0},
-                                      {c.x() + half.x() - 0.4, c.y() + half.y() - 0.1, 0.25},
-                                      "pigment { rgb 0.03 }"));
+          addSedan(sc.primitives, c, t, "pigment { " + col + " } finish { specular 0.3 }",
+                   "pigment { rgb 0.03 }");
         }
       }
     }

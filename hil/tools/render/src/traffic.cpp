@@ -12,10 +12,6 @@ Status range(const std::string& key, const std::string& r) {
   return invalidArgument("traffic." + key + " out of range " + r);
 }
 
-Primitive box(const Eigen::Vector3d& a, const Eigen::Vector3d& b, std::string texture) {
-  return {Primitive::Kind::kBox, a, b, 0.0, std::move(texture)};
-}
-
 constexpr std::array<const char*, kStyleCars> kClassicPaint = {
     "pigment { rgb <0.55,0.08,0.06> } finish { specular 0.3 }",
     "pigment { rgb <0.08,0.15,0.45> } finish { specular 0.3 }",
@@ -86,20 +82,10 @@ std::vector<Primitive> trafficAt(const std::vector<MovingCar>& cars, double t_s,
   for (const MovingCar& car : cars) {
     const Eigen::Vector2d c = car.positionAt(t_s);
     if ((c - ego_xy).norm() < o.clearance_m) continue;
-    // A sedan 4.2 x 1.8 m (as the parked ones): body, glass cabin, dark tyre band.
-    const Eigen::Vector2d side(-car.dir.y(), car.dir.x());
-    const Eigen::Vector2d half = car.dir.cwiseAbs() * 2.1 + side.cwiseAbs() * 0.9;
-    const Eigen::Vector2d half_cab = car.dir.cwiseAbs() * 1.1 + side.cwiseAbs() * 0.8;
-    const std::string paint = look.styled
-                                  ? "T_car" + std::to_string(car.paint)
-                                  : std::string(kClassicPaint[static_cast<std::size_t>(car.paint)]);
-    out.push_back(box({c.x() - half.x(), c.y() - half.y(), 0.25},
-                      {c.x() + half.x(), c.y() + half.y(), 0.95}, paint));
-    out.push_back(box({c.x() - half_cab.x(), c.y() - half_cab.y(), 0.95},
-                      {c.x() + half_cab.x(), c.y() + half_cab.y(), 1.45}, "T_glass"));
-    out.push_back(box({c.x() - half.x() + 0.4, c.y() - half.y() + 0.1, 0.0},
-                      {c.x() + half.x() - 0.4, c.y() + half.y() - 0.1, 0.25},
-                      look.styled ? "T_tyre" : "pigment { rgb 0.03 }"));
+    addSedan(out, c, car.dir,
+             look.styled ? "T_car" + std::to_string(car.paint)
+                         : std::string(kClassicPaint[static_cast<std::size_t>(car.paint)]),
+             look.styled ? "T_tyre" : "pigment { rgb 0.03 }");
   }
   return out;
 }

@@ -75,6 +75,12 @@ inline constexpr int kStyleCars = 6;     // T_car0..T_car5
 
 City generateCity(const CityOptions& options, std::uint64_t seed, const CityLook& look = {});
 
+// A sedan, 4.2 m long and 1.8 m wide, centred at c on the ground with its length along the unit
+// street axis `along`: a body from 0.25 to 0.95 m in `paint`, a cabin to 1.45 m in T_glass and a
+// tyre band below in `tyre`. The parked cars (generateCity) and the moving ones (traffic.hpp).
+void addSedan(std::vector<Primitive>& out, const Eigen::Vector2d& c, const Eigen::Vector2d& along,
+              const std::string& paint, const std::string& tyre);
+
 struct RouteOptions {
   double speed_min_mps = 8.0;               // cruise speed range, m/s, [1, 40]
   double speed_max_mps = 12.0;              // m/s, [speed_min_mps, 40]
