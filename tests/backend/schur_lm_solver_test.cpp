@@ -90,6 +90,9 @@ Result run(const Scenario& sc, WindowSolver solver, int frames = 6) {
   wo.loss = sc.loss;
   wo.max_num_iterations = 100;
   wo.max_solver_time_in_seconds = 30.0;  // bounded by iterations, also under qemu-aarch64
+  // The fixed-std rotation-rate prior: in the problem from the first solve on (the adapted one
+  // waits for RateSpread::kMinSamples frames of the vehicle's own rates).
+  wo.rate_prior_adapt_frames = 0;
   if (sc.with_prior) {
     wo.motion_prior_sigma_rot_deg = 0.2;
     wo.motion_prior_sigma_trans_m = 0.05;

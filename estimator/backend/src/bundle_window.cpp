@@ -47,6 +47,10 @@ Status WindowOptions::validate() const {
       return invalidArgument(std::string("window.") + key + " must be in [0, 1000]");
     }
   }
+  if (rate_prior_adapt_frames < 0 || rate_prior_adapt_frames > RateSpread::kMaxFrames) {
+    return invalidArgument("window.rate_prior_adapt_frames must be in [0, " +
+                           std::to_string(RateSpread::kMaxFrames) + "]");
+  }
   if (!(yaw_axis_memory_s > 0.0 && yaw_axis_memory_s <= 1e6)) {
     return invalidArgument("window.yaw_axis_memory_s must be in (0, 1e6]");
   }
@@ -100,6 +104,7 @@ Status BundleWindow::init(const WindowOptions& options, const StereoCamera& came
   yaw_scatter_ = w0 * w0 * yaw_axis_c_ * yaw_axis_c_.transpose();
   saved_yaw_scatter_ = yaw_scatter_;
   saved_yaw_axis_c_ = yaw_axis_c_;
+  rate_spread_.setCapacity(options.rate_prior_adapt_frames);
   num_residuals_ = 0;
 
   switch (options.loss) {
@@ -424,6 +429,7 @@ Expected<WindowSolveSummary> BundleWindow::solve() {
   saved_poses_ = poses_;
   saved_yaw_scatter_ = yaw_scatter_;
   saved_yaw_axis_c_ = yaw_axis_c_;
+  rate_spread_.commit();
   if (hook_) {
     in_hook_ = true;
     const Status s = hook_(*this);
@@ -459,19 +465,37 @@ Expected<WindowSolveSummary> BundleWindow::solve() {
   return out;
 }
 
-// Rotation-rate priors between consecutive slots (RotationRatePriorResidual): basis rows = the
-// pitch-like direction e1 = a x e2, the yaw axis a, the roll-like direction e2 (the optical axis
-// made orthogonal to a); std = rate std x dt per row.
+namespace {
+// The rotation-rate prior's basis for the yaw axis a (unit, camera frame): the pitch-like
+// direction e1 = a x e2, a, and the roll-like direction e2 (the optical axis made orthogonal to a).
+Eigen::Matrix3d rateBasis(const Eigen::Vector3d& a) {
+  const Eigen::Vector3d e2 = (Eigen::Vector3d::UnitZ() - a.z() * a).normalized();
+  Eigen::Matrix3d B;
+  B.row(0) = a.cross(e2).transpose();
+  B.row(1) = a.transpose();
+  B.row(2) = e2.transpose();
+  return B;
+}
+}  // namespace
+
+// Rotation-rate priors between consecutive slots (RotationRatePriorResidual): basis rows
+// rateBasis(yaw axis); std = rate std x dt per row, the rate std raised to the spread of the
+// vehicle's own recent rates on that axis (RateSpread). While that spread is not known yet (the
+// first frames after init()) there is no prior: a 2 deg/s prior on a vehicle rolling at 15 deg/s
+// would tilt the start of the drive, and a drift prior has nothing to do in the first second.
 Status BundleWindow::addRatePriors(WindowSolveSummary& out, bool use_ceres) {
   constexpr double kDegToRad = M_PI / 180.0;
-  const double rates[3] = {options_.rate_prior_pitch_deg_s * kDegToRad,
-                           options_.rate_prior_yaw_deg_s * kDegToRad,
-                           options_.rate_prior_roll_deg_s * kDegToRad};
+  if (rate_spread_.capacity() > 0 && !rate_spread_.ready()) return Status::ok();
+  const Eigen::Vector3d spread = rate_spread_.spread();
+  double rates[3] = {options_.rate_prior_pitch_deg_s * kDegToRad,
+                     options_.rate_prior_yaw_deg_s * kDegToRad,
+                     options_.rate_prior_roll_deg_s * kDegToRad};
+  for (int i = 0; i < 3; ++i) {
+    if (rates[i] > 0.0) rates[i] = std::max(rates[i], spread[i]);
+    out.rate_prior_std_deg_s[static_cast<std::size_t>(i)] = rates[i] / kDegToRad;
+  }
   if (!(rates[0] > 0.0 || rates[1] > 0.0 || rates[2] > 0.0)) return Status::ok();
-  const Eigen::Vector3d& a = yaw_axis_c_;
-  const Eigen::Vector3d e2 = (Eigen::Vector3d::UnitZ() - a.z() * a).normalized();
-  const Eigen::Vector3d e1 = a.cross(e2);
-  const Eigen::Vector3d rows[3] = {e1, a, e2};
+  const Eigen::Matrix3d B = rateBasis(yaw_axis_c_);
   for (int s = 1; s < size_; ++s) {
     const auto us = static_cast<std::size_t>(s);
     double dt_s = static_cast<double>(frames_[us].time_ns - frames_[us - 1].time_ns) * 1e-9;
@@ -481,7 +505,7 @@ Status BundleWindow::addRatePriors(WindowSolveSummary& out, bool use_ceres) {
     RotationRatePriorData& d = frames_[us].rate_prior;
     for (int i = 0; i < 3; ++i) {
       d.sqrt_info[i] = rates[i] > 0.0 ? 1.0 / (rates[i] * dt_s) : 0.0;
-      for (int j = 0; j < 3; ++j) d.basis[3 * i + j] = rows[i][j];
+      for (int j = 0; j < 3; ++j) d.basis[3 * i + j] = B(i, j);
     }
     ++out.num_rate_prior_residuals;
     if (!use_ceres) {
@@ -510,6 +534,8 @@ void BundleWindow::updateYawAxis() {
   const Isometry3 T_k_km1 = T_k_b(size_ - 1) * T_k_b(size_ - 2).inverse();
   const Eigen::Vector3d phi = logSO3(T_k_km1.linear());
   if (!phi.allFinite() || !(dt_s > 0.0) || !std::isfinite(dt_s)) return;
+  // The rate about the prior's axes as they were in this solve (before the axis moves).
+  rate_spread_.push(rateBasis(yaw_axis_c_) * phi / std::max(dt_s, 1e-3));
   const double lambda = std::exp(-dt_s / options_.yaw_axis_memory_s);
   const double w0 = options_.yaw_axis_prior_deg * M_PI / 180.0;
   const Eigen::Vector3d y = Eigen::Vector3d::UnitY();

@@ -88,6 +88,7 @@ int main(int argc, char** argv) {
                "online stereo self-calibration of the right camera (measures the right rows); its "
                "estimate per frame in OUT/self_calibration_<run>.csv");
   sunvo::cli::addSelfCalibrationRateOptions(app, options.pipeline.self_calibration);
+  sunvo::cli::addRotationRatePriorOptions(app, options.pipeline.vo.window);
   app.add_option("--estimators", estimator_names,
                  "also VO + sun from these image estimators: lalonde, lalonde_vo, sun_cnn")
       ->delimiter(',')

@@ -31,6 +31,7 @@
 #include <string_view>
 #include <vector>
 
+#include "sunvo/backend/rate_spread.hpp"
 #include "sunvo/backend/schur_lm_solver.hpp"
 #include "sunvo/backend/stereo_residual.hpp"
 #include "sunvo/core/camera.hpp"
@@ -74,17 +75,22 @@ struct WindowOptions {
   // Zero-mean prior on each window frame's rotation relative to the previous window frame
   // (issue 15; RotationRatePriorResidual) along the pitch-like and roll-like directions
   // orthogonal to the vehicle's yaw axis: std = rate std x dt, dt from the frame times (no prior
-  // when dt <= 0, dt taken as at least 1 ms). A ground vehicle's roll and pitch stay bounded; typical passenger-car body
-  // rates in normal driving are a few deg/s (roll gradient 3-6 deg/g with lateral jerk < 0.5 g/s;
-  // body modes at 1-1.5 Hz of 0.2-0.5 deg). It matters only on an axis the tracks constrain
-  // weakly (tracks on one side of the image leave roll weak). The yaw axis in the camera frame
-  // is the principal axis of the window's own per-frame rotations (turns dominate it),
-  // exponentially forgotten, starting at and regularised towards the camera's y axis (a camera
+  // when dt <= 0, dt taken as at least 1 ms). A ground vehicle's roll and pitch stay bounded;
+  // typical passenger-car body rates in normal driving are a few deg/s (roll gradient 3-6 deg/g
+  // with lateral jerk < 0.5 g/s; body modes at 1-1.5 Hz of 0.2-0.5 deg). It matters only on an axis
+  // the tracks constrain weakly (tracks on one side of the image leave roll weak). The yaw axis in
+  // the camera frame is the principal axis of the window's own per-frame rotations (turns dominate
+  // it), exponentially forgotten, starting at and regularised towards the camera's y axis (a camera
   // looking along the direction of travel, x right, y down).
   bool rotation_rate_prior = true;      // on/off
   double rate_prior_pitch_deg_s = 2.0;  // deg/s, [0, 1000]: 0 = no prior on pitch
   double rate_prior_yaw_deg_s = 0.0;    // deg/s, [0, 1000]: 0 = none (turns are the motion)
   double rate_prior_roll_deg_s = 2.0;   // deg/s, [0, 1000]: 0 = no prior on roll
+  // The stds above are for a car on a paved road. On rough ground the vehicle itself pitches and
+  // rolls at 10+ deg/s and a 2 deg/s prior pulls every frame's true rotation towards 0: each
+  // axis's std is raised to the robust spread of the window's own solved rates about it over the
+  // last N frames (RateSpread: 1.4826 x median |rate|), never lowered below the value above.
+  int rate_prior_adapt_frames = 50;  // count, [0, 256]: 0 = the fixed stds above
   // Yaw-axis estimate: memory tau spans a few turns of urban driving; the regulariser outweighs
   // what the body-rate wobble adds over tau on a straight road ((rate std x dt)^2 x tau / dt =
   // (0.2 deg)^2 x 200 frames = 8 deg^2 at 2 deg/s and 10 Hz < 9 deg^2), so a long straight
@@ -114,6 +120,7 @@ struct WindowOptions {
     v("rate_prior_pitch_deg_s", s.rate_prior_pitch_deg_s);
     v("rate_prior_yaw_deg_s", s.rate_prior_yaw_deg_s);
     v("rate_prior_roll_deg_s", s.rate_prior_roll_deg_s);
+    v("rate_prior_adapt_frames", s.rate_prior_adapt_frames);
     v("yaw_axis_memory_s", s.yaw_axis_memory_s);
     v("yaw_axis_prior_deg", s.yaw_axis_prior_deg);
   }
@@ -130,6 +137,9 @@ struct WindowSolveSummary {
   int num_stereo_residuals = 0;
   int num_prior_residuals = 0;
   int num_rate_prior_residuals = 0;  // rotation-rate priors (WindowOptions::rotation_rate_prior)
+  // Their stds along the pitch-like direction, the yaw axis and the roll-like direction, deg/s
+  // (after WindowOptions::rate_prior_adapt_frames; 0 = no prior on that axis).
+  std::array<double, 3> rate_prior_std_deg_s{0.0, 0.0, 0.0};
   int num_extra_residuals = 0;
   int iterations = 0;
   double solver_time_s = 0.0;
@@ -165,11 +175,13 @@ class BundleWindow {
   Expected<WindowSolveSummary> solve();
 
   // Puts every pose back to the initial guess it had before the last solve() (e.g. when the
-  // caller rejects the solution), and the yaw-axis estimate to what it was before that solve.
+  // caller rejects the solution), and the yaw-axis estimate and the rate spread to what they were
+  // before that solve.
   void restoreInitialGuess() {
     poses_ = saved_poses_;
     yaw_scatter_ = saved_yaw_scatter_;
     yaw_axis_c_ = saved_yaw_axis_c_;
+    rate_spread_.undoLastPush();
   }
 
   int size() const { return size_; }
@@ -273,6 +285,7 @@ class BundleWindow {
   Eigen::Vector3d yaw_axis_c_ = Eigen::Vector3d::UnitY();
   Eigen::Matrix3d saved_yaw_scatter_ = Eigen::Matrix3d::Zero();  // before the last solve
   Eigen::Vector3d saved_yaw_axis_c_ = Eigen::Vector3d::UnitY();
+  RateSpread rate_spread_;  // the solved rates about the prior's axes (rate_prior_adapt_frames)
   int num_extra_ = 0;
 };
 

@@ -35,8 +35,8 @@ const char* version();
 
 // The window's rotation-rate prior switches (backend::WindowOptions, docs/backend.md), the same
 // in every program that runs the back end: --no-rate-prior, --rate-prior-pitch/-yaw/-roll
-// (deg/s), --yaw-axis-memory-s, --yaw-axis-prior-deg. A template so that this library needs
-// nothing of the back end.
+// (deg/s), --rate-prior-adapt-frames, --yaw-axis-memory-s, --yaw-axis-prior-deg. A template so that
+// this library needs nothing of the back end.
 template <class WindowOptions>
 void addRotationRatePriorOptions(CLI::App& app, WindowOptions& win) {
   app.add_flag(
@@ -51,6 +51,10 @@ void addRotationRatePriorOptions(CLI::App& app, WindowOptions& win) {
   app.add_option("--rate-prior-roll", win.rate_prior_roll_deg_s,
                  "rotation-rate prior std about the optical axis, deg/s (0 = none)")
       ->check(CLI::Range(0.0, 1000.0));
+  app.add_option("--rate-prior-adapt-frames", win.rate_prior_adapt_frames,
+                 "frames of the vehicle's own rates whose spread raises the rate prior's std "
+                 "(0 = fixed std)")
+      ->check(CLI::Range(0, 256));
   app.add_option("--yaw-axis-memory-s", win.yaw_axis_memory_s,
                  "time constant of the window's yaw-axis estimate, s")
       ->check(CLI::Range(1e-3, 1e6));
