@@ -21,6 +21,8 @@
 # folder per scenario (config/scenarios/): train_* (training; styled, training looks), val_*
 # (validation: held-out places, times and looks; the sigma scale and validity threshold are
 # chosen on it) and test_* (held-out looks, reported only).
+# config/scenarios/candidate_*.yaml (24 extreme-sun drives) are neither rendered nor trained: they
+# made a one-member model worse on the validation drives (docs/sun_cnn.md).
 # The manifest is $SUNVO_RENDERS/sun_cnn_manifest.csv.
 set -euo pipefail
 ROOT="$(cd "$(dirname "$0")/.." && pwd)"
