@@ -40,6 +40,11 @@ TEST(RoverConfig, TheShippedConfigsLoad) {
   EXPECT_EQ(rover->source.type, SourceType::kV4l2);
   EXPECT_EQ(rover->trigger.type, TriggerType::kGpio);
   EXPECT_EQ(rover->sun.model, "/usr/share/sunvo/sun_cnn_gray.onnx");  // installed by the .deb
+  // The image estimator's azimuth error is a state of the fusion (docs/fusion_bias.md); the
+  // replay file's true sun has none.
+  EXPECT_EQ(rover->estimator.fusion.sun_bias_sigma_deg, 30.0);
+  EXPECT_EQ(rover->estimator.fusion.sun_bias_length_frames, 2500.0);
+  EXPECT_EQ(replay->estimator.fusion.sun_bias_sigma_deg, 0.0);
   auto gray = loadRoverConfig(std::string(SUNVO_SOURCE_DIR) + "/config/rover.yaml",
                               {{"sun.provider", "sun_cnn"}});
   EXPECT_TRUE(gray) << gray.status().toString();

@@ -201,5 +201,20 @@ TEST(Replay, ImageEstimatorCapIsValidated) {
   EXPECT_FALSE(options.validate().isOk());
 }
 
+// The image estimators' bias state: on by default (docs/fusion_bias.md), applied to their fusion
+// only, its ranges the fusion's own.
+TEST(Replay, ImageEstimatorBiasStateIsTheirsAndValidated) {
+  ReplayOptions options;
+  options.dataset.path = "d";
+  EXPECT_EQ(options.fusion.sun_bias_sigma_deg, 0.0);
+  EXPECT_EQ(options.imageFusion().sun_bias_sigma_deg, 30.0);
+  EXPECT_EQ(options.imageFusion().sun_bias_length_frames, 2500.0);
+  options.image_sun_bias_sigma_deg = 50.0;
+  EXPECT_NE(options.validate().message().find("sun_bias_sigma_deg"), std::string::npos);
+  options.image_sun_bias_sigma_deg = 0.0;
+  options.image_sun_bias_length_frames = 0.5;
+  EXPECT_NE(options.validate().message().find("sun_bias_length_frames"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace sunvo::replay

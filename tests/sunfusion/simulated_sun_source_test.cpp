@@ -123,6 +123,41 @@ TEST(SimulatedSunSource, CorrelatedAzimuthBiasIsAGaussMarkovProcessOnTop) {
   EXPECT_NE(bad.validate().message().find("sun_error.azimuth_bias_length"), std::string::npos);
 }
 
+// A constant azimuth offset (a source biased for a whole drive) turns every non-outlier
+// measurement by exactly that angle and changes no other draw; outliers stay uniform.
+TEST(SimulatedSunSource, AzimuthOffsetTurnsEveryMeasurementByTheSameAngle) {
+  SunErrorModel plain;
+  plain.azimuth_sigma_deg = 10.0;
+  plain.outlier_share = 0.1;
+  plain.dropout_share = 0.2;
+  SunErrorModel offset = plain;
+  offset.azimuth_offset_deg = -66.0;
+  ASSERT_TRUE(offset.validate().isOk());
+  SimulatedSunSource a(offset), b(plain);
+  const Eigen::Vector3d truth = sunFromAzimuthZenith(10.0 * kDeg, 60.0 * kDeg);
+  int turned = 0, same = 0, measured = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const auto ma = a.measure(static_cast<std::uint64_t>(i), 0, truth);
+    const auto mb = b.measure(static_cast<std::uint64_t>(i), 0, truth);
+    ASSERT_EQ(ma.has_value(), mb.has_value());
+    if (!ma) continue;
+    ++measured;
+    double az_a = 0, az_b = 0, z_a = 0, z_b = 0;
+    azimuthZenithFromSun(ma->sun_c, az_a, z_a);
+    azimuthZenithFromSun(mb->sun_c, az_b, z_b);
+    ASSERT_NEAR(z_a, z_b, 1e-9) << i;
+    const double d = wrap(az_a - az_b);
+    if (std::abs(d + 66.0 * kDeg) < 1e-9) ++turned;
+    if (std::abs(d) < 1e-9) ++same;  // an outlier: the offset is not added
+  }
+  EXPECT_EQ(turned + same, measured);  // nothing else changed
+  EXPECT_GT(turned, 1300);             // about 0.8 x 0.9 x 2000
+  EXPECT_GT(same, 100);                // the outliers, about 0.8 x 0.1 x 2000
+  SunErrorModel bad = plain;
+  bad.azimuth_offset_deg = 181.0;
+  EXPECT_NE(bad.validate().message().find("sun_error.azimuth_offset_deg"), std::string::npos);
+}
+
 TEST(SimulatedVerticalSource, ErrorsDropoutsOutliersAndBiasAsModelled) {
   // Truth: a camera rolled by 3 deg. The pitch error (about camera x) and roll error (about z) of
   // each measurement: mean = bias, std = sigma; 8 deg outliers; dropouts.

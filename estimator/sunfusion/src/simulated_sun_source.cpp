@@ -36,6 +36,9 @@ Status SunErrorModel::validate() const {
   if (!(azimuth_bias_length >= 1.0 && azimuth_bias_length <= 1e6)) {
     return invalidArgument("sun_error.azimuth_bias_length out of range [1, 1e6]");
   }
+  if (!(azimuth_offset_deg >= -180.0 && azimuth_offset_deg <= 180.0)) {
+    return invalidArgument("sun_error.azimuth_offset_deg out of range [-180, 180]");
+  }
   return Status::ok();
 }
 
@@ -125,7 +128,7 @@ std::optional<SunMeasurement> SimulatedSunSource::measure(std::uint64_t sequence
     zen = std::acos(out_zen);  // uniform over the upper hemisphere's solid angle
   } else {
     if (u_flip < model_.flip_share) az += M_PI;
-    az += n_az * model_.azimuth_sigma_deg * kDeg + bias_;
+    az += (n_az * model_.azimuth_sigma_deg + model_.azimuth_offset_deg) * kDeg + bias_;
     zen += (model_.zenith_bias_deg + n_zen * model_.zenith_sigma_deg) * kDeg;
     zen = std::clamp(zen, 0.0, M_PI);
   }

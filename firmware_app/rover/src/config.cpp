@@ -252,6 +252,8 @@ pipeline::SunAidedOptions roverEstimatorDefaults() {
   pipeline::SunAidedOptions o;
   o.pipeline.vo.window.max_solver_time_in_seconds = 0.040;
   o.fusion.max_drift_deg_per_frame = 0.01;
+  o.fusion.sun_bias_sigma_deg = 30.0;  // docs/fusion_bias.md, "Sources biased for a whole drive"
+  o.fusion.sun_bias_length_frames = 2500.0;
   return o;
 }
 

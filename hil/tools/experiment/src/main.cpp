@@ -56,7 +56,7 @@ int main(int argc, char** argv) {
   int frames = 0, every = 5, seed = 1;
   std::optional<double> drift_deg, sun_loss, initial_sigma_deg, max_drift_deg, innovation_gate;
   std::optional<double> evidence_sigmas, evidence_correlation, max_correction_deg;
-  double sun_bias_deg = 0.0, sun_bias_length = 50.0;
+  double sun_bias_deg = 0.0, sun_bias_length = 50.0, sun_offset_deg = 0.0;
   bool paper_form = false;
   bool write_poses = false;
   bool fixed_drift = false;
@@ -126,11 +126,15 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1.0, 1000.0));
   app.add_option("--sun-bias-deg", sun_bias_deg,
                  "give the estimator-like sources a correlated azimuth error of this std, deg "
-                 "(a Gauss-Markov process, docs/experiment.md)")
+                 "(a Gauss-Markov process, docs/fusion_bias.md)")
       ->check(CLI::Range(0.0, 90.0));
   app.add_option("--sun-bias-length", sun_bias_length,
                  "its correlation length, measurements (50 = 250 frames at --every 5)")
       ->check(CLI::Range(1.0, 1e6));
+  app.add_option("--sun-offset-deg", sun_offset_deg,
+                 "give the estimator-like sources a constant azimuth error, deg (a source biased "
+                 "for a whole drive)")
+      ->check(CLI::Range(-180.0, 180.0));
   sunvo::cli::addBiasStateOptions(app, options.fusion);
   app.add_option("--max-correction-deg", max_correction_deg,
                  "refuse a measurement that would turn the attitude more, deg (0 = off)")
@@ -202,6 +206,7 @@ int main(int argc, char** argv) {
     if (src.model.azimuth_sigma_deg == 0.0) continue;  // the true vector stays exact
     src.model.azimuth_bias_deg = sun_bias_deg;
     src.model.azimuth_bias_length = sun_bias_length;
+    src.model.azimuth_offset_deg = sun_offset_deg;
   }
   vertical_model.seed = static_cast<std::uint32_t>(seed) + 10;  // the sun sources use seed..seed+3
 

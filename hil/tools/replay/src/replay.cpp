@@ -16,9 +16,12 @@ Status ReplayOptions::validate() const {
   if (max_consecutive_bad_frames < 0 || max_consecutive_bad_frames > 100000) {
     return invalidArgument("replay.max_consecutive_bad_frames out of range [0, 100000]");
   }
-  // The cap's range is the fusion's own (min <= cap <= 5), checked by the fusion itself.
+  // The image options' ranges are the fusion's own, checked by the fusion itself.
   if (const Status s = imageFusion().validate(); !s.isOk()) {
-    return invalidArgument("replay.image_max_drift_deg_per_frame: " + s.message());
+    return invalidArgument(
+        "replay.image_max_drift_deg_per_frame / image_sun_bias_sigma_deg / "
+        "image_sun_bias_length_frames: " +
+        s.message());
   }
   return Status::ok();
 }
@@ -26,6 +29,8 @@ Status ReplayOptions::validate() const {
 sunfusion::SunFusionOptions ReplayOptions::imageFusion() const {
   sunfusion::SunFusionOptions f = fusion;
   f.max_drift_deg_per_frame = image_max_drift_deg_per_frame;
+  f.sun_bias_sigma_deg = image_sun_bias_sigma_deg;
+  f.sun_bias_length_frames = image_sun_bias_length_frames;
   return f;
 }
 

@@ -7,7 +7,9 @@
 // Errors are drawn per measurement, in order:
 //   dropout (no measurement) -> gross outlier (uniform azimuth, zenith uniform over the upper
 //   hemisphere) -> shadow ambiguity flip (psi + 180 deg, the bimodal shadow cue) -> Gaussian
-//   azimuth and zenith errors, the zenith with a bias (Lalonde's zenith prior skews it).
+//   azimuth and zenith errors, the zenith with a bias (Lalonde's zenith prior skews it), and a
+//   constant azimuth offset (an estimator that is wrong the same way on a whole drive: the
+//   Sun-CNN on a foreign generator's drive ran at -66 deg for 260 frames, issue 14).
 // Optionally the azimuth also carries an error that is correlated from measurement to measurement
 // (an image estimator that is wrong the same way along a whole street): a first-order
 // Gauss-Markov process b_{i+1} = phi b_i + sqrt(1 - phi^2) sigma_b n_i, phi = exp(-1 / tau), with
@@ -36,6 +38,7 @@ struct SunErrorModel {
   double reported_sigma = 0.15;     // sigma written into each measurement (sets R_s), (0, 2]
   double azimuth_bias_deg = 0.0;    // std of the correlated azimuth error, [0, 90] deg; 0 = none
   double azimuth_bias_length = 50;  // its correlation length, [1, 1e6] measurements
+  double azimuth_offset_deg = 0.0;  // constant azimuth error of every non-outlier, [-180, 180] deg
   std::uint32_t seed = 1;           // RNG seed
 
   Status validate() const;

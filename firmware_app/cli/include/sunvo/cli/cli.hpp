@@ -63,7 +63,7 @@ void addRotationRatePriorOptions(CLI::App& app, WindowOptions& win) {
       ->check(CLI::Range(1e-3, 180.0));
 }
 
-// The fusion's sun azimuth bias state (sunfusion::SunFusionOptions, docs/experiment.md), the same
+// The fusion's sun azimuth bias state (sunfusion::SunFusionOptions, docs/fusion_bias.md), the same
 // in every program that runs the fusion: --bias-state-deg, --bias-state-frames.
 template <class FusionOptions>
 void addBiasStateOptions(CLI::App& app, FusionOptions& fusion) {

@@ -48,13 +48,22 @@ struct ReplayOptions {
   // the random walk's start value: on the three benchmark drives Sun-CNN made VO worse by up to
   // +246 % rot. ARMSE with 0.05, and by at most +0.5 % with 0.01 (docs/sun_estimators.md).
   double image_max_drift_deg_per_frame = 0.01;
+  // The image estimators' azimuth error as a state of the fusion (fusion.sun_bias_sigma_deg and
+  // sun_bias_length_frames, docs/fusion_bias.md "Sources biased for a whole drive"): an estimator
+  // that meets a look it was not trained on can be wrong by the same tens of degrees for a whole
+  // drive (the Sun-CNN ran at -66 deg on a foreign generator's drive, issue 14), and without the
+  // state the fusion follows it (+80 ... +2900 % final drift with a -30 or -66 deg offset on the
+  // simulated routes). 30 deg puts such an offset within about 2 sigma; 2500 frames (about 4 min
+  // at 10 Hz) is a drive's look, longer than a street. Std deg [0, 45], 0 = none; frames [1, 1e6].
+  double image_sun_bias_sigma_deg = 30.0;
+  double image_sun_bias_length_frames = 2500.0;
   // Bad frames in a row that are dropped before the run stops with the last one's error, frames,
   // [0, 100000]; 0 = the first bad frame stops the run (and open() needs every image file).
   int max_consecutive_bad_frames = 10;
   // Keep every processed frame's front-end output (ReplayRun::features), e.g. to write the drive's
   // tracks as a track folder (files::writeTrackFolder).
   bool record_features = false;
-  // The fusion options of an image-estimator run: `fusion` with the cap above.
+  // The fusion options of an image-estimator run: `fusion` with the cap and the bias state above.
   sunfusion::SunFusionOptions imageFusion() const;
   Status validate() const;
 };
