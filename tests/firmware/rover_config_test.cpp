@@ -45,6 +45,9 @@ TEST(RoverConfig, TheShippedConfigsLoad) {
   EXPECT_EQ(rover->estimator.fusion.sun_bias_sigma_deg, 30.0);
   EXPECT_EQ(rover->estimator.fusion.sun_bias_length_frames, 2500.0);
   EXPECT_EQ(replay->estimator.fusion.sun_bias_sigma_deg, 0.0);
+  // The vertical cue, in the sun thread, with time to answer (docs/vertical.md).
+  EXPECT_TRUE(rover->estimator.vertical.enabled);
+  EXPECT_GE(rover->realtime.sun_wait_ms, 20.0);
   auto gray = loadRoverConfig(std::string(SUNVO_SOURCE_DIR) + "/config/rover.yaml",
                               {{"sun.provider", "sun_cnn"}});
   EXPECT_TRUE(gray) << gray.status().toString();

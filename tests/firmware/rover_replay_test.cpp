@@ -193,6 +193,35 @@ TEST(RoverReplay, SunCnnProviderEveryFifthFrame) {
   EXPECT_EQ(std::atoi(m[1].str().c_str()), expected_calls);  // every call answered
 }
 
+// estimator.vertical.enabled without a sun provider (config/rover.yaml's deployment setting): the
+// cue runs in the sun thread on every fifth frame, every call is answered and its "up" reaches the
+// fusion in time, the estimator thread allocates nothing after the warm-up (the cue does, in the
+// sun thread), and every pose still arrives.
+TEST(RoverReplay, VerticalCueInTheSunThread) {
+  int frames = 0;
+  const std::string drive = findOrRenderDrive(&frames);
+  ASSERT_FALSE(drive.empty()) << "no rendered drive";
+  const ProgramRun run = runProgram(drive, frames, "rover_vertical",
+                                    " --set sun.provider=none --set estimator.vertical.enabled=true"
+                                    " --set realtime.sun_wait_ms=60");
+  EXPECT_EQ(run.rc, 0);
+  EXPECT_EQ(jsonNumber(run.json, "odometry_received"), frames);
+  const std::regex re(
+      "vertical cue \\(sun thread\\): calls ([0-9]+), valid ([0-9]+), refused images ([0-9]+), "
+      "accepted ([0-9]+)");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(run.log, m, re)) << run.log;
+  const int expected_calls = (frames - 1) / 5;  // sequences 5, 10, ... below frames
+  EXPECT_EQ(std::atoi(m[1].str().c_str()), expected_calls);
+  EXPECT_EQ(std::atoi(m[3].str().c_str()), 0);
+  EXPECT_GT(std::atoi(m[2].str().c_str()), expected_calls / 2);  // the CI drive: 39 of 39
+  EXPECT_GT(std::atoi(m[4].str().c_str()), 0);
+  const std::regex alloc("allocations after warm-up, estimator +([0-9]+) in");
+  if (std::regex_search(run.log, m, alloc)) {
+    EXPECT_EQ(std::atoi(m[1].str().c_str()), 0);
+  }
+}
+
 // A copy of the rendered drive's gray images, OXTS and calibration (no colour pair) with injected
 // image faults: frame 3's left image missing, frame 4's right image truncated, frame 9's left
 // image of the wrong size and frame 14's right image with three channels.

@@ -39,7 +39,8 @@ Status SunAidedOdometry::init(const SunAidedOptions& options, const StereoCamera
   selfcal_report_ = selfcal::SelfCalibrationReport{};
   selfcal_ms_ = 0.0;
   backend::BundleWindow& window = backEnd().window();
-  vertical_active_ = options.vertical.enabled && input == OdometryInput::kImages;
+  vertical_active_ =
+      options.vertical.enabled && options.vertical.measure_here && input == OdometryInput::kImages;
   vertical_stats_ = VerticalStats{};
   if (vertical_active_) SUNVO_RETURN_IF_ERROR(vertical_.init(options.vertical.estimator, camera));
   if (options.use_sun || options.vertical.enabled) {

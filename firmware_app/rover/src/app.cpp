@@ -156,6 +156,8 @@ Expected<std::unique_ptr<RoverApp>> RoverApp::create(const RoverConfig& config,
   SUNVO_RETURN_IF_ERROR(config.validate());
   auto impl = std::make_unique<Impl>(config);
   const bool needs_images = sunProviderNeedsImages(config.sun.provider);
+  // The vertical cue runs in the sun thread on a copy of the grey left image.
+  const bool cue = config.estimator.vertical.enabled;
   SUNVO_RETURN_IF_ERROR(impl->openDevices(devices, needs_images));
   const StereoCamera camera = impl->source->camera();
   if (camera.width != config.frames.width || camera.height != config.frames.height) {
@@ -184,7 +186,7 @@ Expected<std::unique_ptr<RoverApp>> RoverApp::create(const RoverConfig& config,
   impl->pool = std::move(*pool);
   auto provider = makeSunProvider(config.sun, camera);
   if (!provider) return provider.status();
-  if (*provider && (*provider)->needsImages()) {
+  if ((*provider && (*provider)->needsImages()) || cue) {
     runtime::FramePoolOptions so = config.frames;
     so.pool_depth = config.queues.sun_requests + 2;
     so.color = colour_frames;
@@ -200,9 +202,13 @@ Expected<std::unique_ptr<RoverApp>> RoverApp::create(const RoverConfig& config,
   SUNVO_RETURN_IF_ERROR(impl->estimator->init(camera, world->T_w_c0, *provider != nullptr));
   impl->capture = std::make_unique<CaptureStage>(*impl->ctx, *impl->trigger, *impl->source,
                                                  impl->estimator->odometry());
-  if (*provider) {
+  if (*provider || cue) {
     impl->sun =
         std::make_unique<SunStage>(*impl->ctx, impl->attitude, std::move(*provider), world->origin);
+    if (cue) {
+      const Status s = impl->sun->initVerticalCue(config.estimator.vertical.estimator, camera);
+      if (!s.isOk()) return Status(s.code(), config.path + ": estimator.vertical." + s.message());
+    }
   }
   std::unique_ptr<TumPoseLog> pose_log;
   if (!config.telemetry.pose_log.empty()) {
@@ -405,8 +411,16 @@ std::string RoverApp::summary() const {
   appendf(&o,
           "  sun (%s): requests %" PRIu64 ", measurements %" PRIu64 ", errors %" PRIu64
           ", late %" PRIu64 ", accepted %" PRIu64 ", rejected %" PRIu64 "\n",
-          s.sun ? s.sun->provider()->name() : "none", g(h.sun_requests), g(h.sun_measurements),
-          g(h.sun_errors), g(h.sun_late), g(h.sun_accepted), g(h.sun_rejected));
+          s.sun && s.sun->provider() ? s.sun->provider()->name() : "none", g(h.sun_requests),
+          g(h.sun_measurements), g(h.sun_errors), g(h.sun_late), g(h.sun_accepted),
+          g(h.sun_rejected));
+  if (s.config.estimator.vertical.enabled) {
+    appendf(&o,
+            "  vertical cue (sun thread): calls %" PRIu64 ", valid %" PRIu64
+            ", refused images %" PRIu64 ", accepted %" PRIu64 ", rejected %" PRIu64 "\n",
+            g(h.vertical_calls), g(h.vertical_valid), g(h.vertical_errors), g(h.vertical_accepted),
+            g(h.vertical_rejected));
+  }
   if (s.telemetry->link() != nullptr)
     o += "  serial: " + s.telemetry->link()->countersText() + "\n";
   if (const TumPoseLog* log = s.telemetry->poseLog()) {

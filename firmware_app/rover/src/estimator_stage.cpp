@@ -12,6 +12,9 @@ Status EstimatorStage::init(const StereoCamera& camera, const Isometry3& T_w_c0,
   pipeline::SunAidedOptions options = c.estimator;
   options.use_sun = use_sun;
   options.fusion.world_up = Eigen::Vector3d::UnitZ();  // ENU
+  // The vertical cue runs in the sun thread (SunStage): it allocates, this loop must not. Its
+  // answers come back with the sun results (takeSunResults).
+  options.vertical.measure_here = false;
   // The frames the estimator accepts are the configured ones.
   options.pipeline.frontend.max_width =
       std::max(options.pipeline.frontend.max_width, c.frames.width);
@@ -27,6 +30,16 @@ void EstimatorStage::takeSunResults(std::uint64_t waiting_for, bool* got) {
   SunResult r;
   while (ctx_.channels.sun_results.pop(&r)) {
     if (r.sequence == waiting_for) *got = true;
+    if (r.has_up) {
+      sunfusion::SunObservation up;
+      up.measurement.time_ns = r.utc_ns;
+      up.measurement.sequence = r.sequence;
+      up.measurement.kind = sunfusion::SunMeasurementKind::kFull3d;
+      up.measurement.sun_c = Eigen::Vector3d(r.up_c[0], r.up_c[1], r.up_c[2]);
+      up.measurement.sigma = r.up_sigma;
+      up.sun_w = Eigen::Vector3d::UnitZ();  // ENU
+      odometry_.addVertical(up);
+    }
     if (!r.has_measurement) continue;
     sunfusion::SunObservation obs;
     obs.measurement.time_ns = r.utc_ns;
@@ -88,6 +101,7 @@ void EstimatorStage::run() {
   double front_ms_mean = 0.0;  // running mean of front end + RANSAC, ms
   bool have_mean = false;
   vo::TrackingStatus last_status = vo::TrackingStatus::kInitializing;
+  const bool cue = odometry_.options().vertical.enabled;
   for (;;) {
     const std::uint32_t key = ch.frames_ev.prepare();
     FrameTicket ticket;
@@ -120,11 +134,12 @@ void EstimatorStage::run() {
     odometry_.setSolverTimeBudget(budget_ms * 1e-3);
     ctx_.profiler.setSolverBudget(seq, budget_ms);
 
-    // Sun results; a sun frame waits a bounded time for its own (the window, size 2, keeps the
-    // frame's rotation free only while it is the newest).
+    // Sun results; a sun frame (or a frame of the vertical cue) waits a bounded time for its own
+    // (the window, size 2, keeps the frame's rotation free only while it is the newest).
     bool got = false;
     takeSunResults(seq, &got);
-    if (odometry_.isSunFrame(seq) && !got) {
+    const bool cue_frame = cue && odometry_.isCueFrame(seq);
+    if ((odometry_.isSunFrame(seq) || cue_frame) && !got) {
       const TimeNs until = runtime::monotonicNs() + sun_wait_ns;
       for (;;) {
         const std::uint32_t skey = ch.sun_results_ev.prepare();
@@ -173,13 +188,18 @@ void EstimatorStage::run() {
     const sunfusion::GateCounters& gate = odometry_.sunCounters();
     health.sun_accepted.store(gate.accepted, std::memory_order_relaxed);
     health.sun_rejected.store(gate.total() - gate.accepted, std::memory_order_relaxed);
+    const sunfusion::GateCounters& vgate = odometry_.verticalCounters();
+    health.vertical_accepted.store(vgate.accepted, std::memory_order_relaxed);
+    health.vertical_rejected.store(vgate.total() - vgate.accepted, std::memory_order_relaxed);
 
     const PoseRecord pose = poseOf(*r, slot);
     ctx_.pool.release(ticket.slot);
     ch.poses.push(pose);  // drop-oldest: a stale pose is of no use
     ch.poses_ev.notify();
     health.frames_processed.fetch_add(1, std::memory_order_relaxed);
-    if (odometry_.options().use_sun) attitude_.publish(Eigen::Quaterniond(r->vo.T_w_c.linear()));
+    if (odometry_.options().use_sun || cue) {
+      attitude_.publish(Eigen::Quaterniond(r->vo.T_w_c.linear()));
+    }
     last_status = status;
     meter_.frameDone();
   }

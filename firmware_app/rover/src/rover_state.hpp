@@ -24,7 +24,8 @@ struct FrameTicket {
   std::uint64_t sequence = 0;
 };
 
-// capture -> sun: a sun frame, with its copy in the sun pool when the provider needs images.
+// capture -> sun: a sun frame (or a frame of the vertical cue), with its copy in the sun pool
+// when the provider or the cue needs images.
 struct SunRequest {
   std::uint64_t sequence = 0;
   std::int64_t source_index = 0;
@@ -41,6 +42,10 @@ struct SunResult {
   double sun_c[3] = {0, 0, 1};
   double sigma = 0.1;
   double sun_w[3] = {0, 0, 1};
+  // The vertical cue (estimator.vertical.enabled): "up" in the camera and its sigma, rad.
+  bool has_up = false;
+  double up_c[3] = {0, -1, 0};
+  double up_sigma = 0.01;
 };
 
 // Counters of everything that can go wrong or be late, written by the stages, read by summary().
@@ -74,6 +79,13 @@ struct Health {
   std::atomic<std::uint64_t> sun_late{0};  // the estimator did not get it in time
   std::atomic<std::uint64_t> sun_accepted{0};
   std::atomic<std::uint64_t> sun_rejected{0};
+  // The vertical cue, measured in the sun thread: calls, valid answers, refused images, and what
+  // the fusion's gates did with the answers.
+  std::atomic<std::uint64_t> vertical_calls{0};
+  std::atomic<std::uint64_t> vertical_valid{0};
+  std::atomic<std::uint64_t> vertical_errors{0};
+  std::atomic<std::uint64_t> vertical_accepted{0};
+  std::atomic<std::uint64_t> vertical_rejected{0};
   std::atomic<std::uint64_t> poses_published{0};
   std::atomic<std::uint64_t> deadline_misses{0};
   std::atomic<std::uint64_t> heartbeats{0};

@@ -17,6 +17,7 @@
 #include "sunvo/runtime/allocation_meter.hpp"
 #include "sunvo/runtime/frame_pool.hpp"
 #include "sunvo/runtime/latency_profiler.hpp"
+#include "sunvo/vertical/vertical_estimator.hpp"
 
 namespace sunvo::rover {
 
@@ -32,7 +33,8 @@ struct StageContext {
 };
 
 // Waits for each trigger, grabs its stereo pair into a free pool slot and queues it; for a sun
-// frame also queues a sun request (with a copy of the left image when the provider needs it).
+// frame (and a frame of the vertical cue) also queues a sun request, with a copy of the left
+// image when the provider or the cue needs it.
 class CaptureStage {
  public:
   CaptureStage(StageContext& ctx, TriggerSource& trigger, FrameSource& source,
@@ -82,21 +84,33 @@ class EstimatorStage {
 };
 
 // The sun in the world (NREL SPA at the origin and the frame's UTC) and the provider's
-// measurement in the camera, for each sun request; off the critical path (low priority).
+// measurement in the camera, for each sun request; off the critical path (low priority). With
+// estimator.vertical.enabled it also measures the camera's "up" on the request's image (the
+// vertical cue allocates, so it runs here and not in the estimator's fixed-memory loop); the
+// provider may then be null (sun.provider: none).
 class SunStage {
  public:
   SunStage(StageContext& ctx, const AttitudeMailbox& attitude,
            std::unique_ptr<SunProvider> provider, const geodesy::GeodeticPoint& origin)
       : ctx_(ctx), attitude_(attitude), provider_(std::move(provider)), origin_(origin) {}
+  // Turns the vertical cue on (before the threads start).
+  Status initVerticalCue(const vertical::VerticalOptions& options, const StereoCamera& camera);
   void run();
   const SunProvider* provider() const { return provider_.get(); }
   runtime::AllocationMeter& meter() { return meter_; }
 
  private:
+  // The provider's sun (with the prior from the last published attitude and the ephemeris).
+  void measureSun(SunQuery& query, SunResult& res);
+  // The cue on the request's left image, with the last published attitude as its prior.
+  void measureUp(const SunQuery& query, SunResult& res);
+
   StageContext& ctx_;
   const AttitudeMailbox& attitude_;
   std::unique_ptr<SunProvider> provider_;
   geodesy::GeodeticPoint origin_;
+  bool cue_ = false;
+  vertical::VerticalEstimator vertical_;
   runtime::AllocationMeter meter_;
 };
 

@@ -4,13 +4,68 @@
 
 namespace sunvo::rover {
 
-void SunStage::run() {
-  Channels& ch = ctx_.channels;
+Status SunStage::initVerticalCue(const vertical::VerticalOptions& options,
+                                 const StereoCamera& camera) {
+  SUNVO_RETURN_IF_ERROR(vertical_.init(options, camera));
+  cue_ = true;
+  return Status::ok();
+}
+
+void SunStage::measureSun(SunQuery& query, SunResult& res) {
   Health& health = ctx_.health;
   sun::SpaOptions spa;
   spa.latitude_deg = origin_.lat_deg;
   spa.longitude_deg = origin_.lon_deg;
   spa.elevation_m = origin_.alt_m;
+  auto sp = sun::computeSolarPosition(query.utc_ns, spa);
+  Eigen::Quaterniond q_w_c_now;
+  if (sp && attitude_.latest(&q_w_c_now)) {
+    // Prior in the camera: sun_c = R_c_w sun_w, up_c = R_c_w (0, 0, 1) with ENU world (z up).
+    // The attitude is the last published pose's, one or a few frames before this one.
+    const Eigen::Matrix3d R_c_w = q_w_c_now.toRotationMatrix().transpose();
+    sunfusion::SunPrior prior;
+    prior.sun_c = (R_c_w * sp->sun_enu).normalized();
+    prior.up_c = R_c_w * Eigen::Vector3d::UnitZ();
+    query.prior = prior;
+  }
+  auto m = provider_->measure(query);
+  if (!sp || !m) {
+    health.sun_errors.fetch_add(1, std::memory_order_relaxed);
+  } else if (m->has_value()) {
+    const sunfusion::SunMeasurement& meas = **m;
+    res.has_measurement = meas.sun_c.allFinite();
+    res.azimuth_only = meas.kind == sunfusion::SunMeasurementKind::kAzimuthOnly;
+    res.sigma = meas.sigma;
+    for (int i = 0; i < 3; ++i) {
+      res.sun_c[i] = meas.sun_c[i];
+      res.sun_w[i] = sp->sun_enu[i];
+    }
+    if (res.has_measurement) health.sun_measurements.fetch_add(1, std::memory_order_relaxed);
+  }
+}
+
+void SunStage::measureUp(const SunQuery& query, SunResult& res) {
+  Eigen::Quaterniond q_w_c;
+  // No prior before the first pose: the cue waits for one (its search is +-max_tilt_deg about it).
+  if (query.images == nullptr || !attitude_.latest(&q_w_c)) return;
+  Health& health = ctx_.health;
+  // up_c = C_c_w up_w, ENU world (z up); the last published pose's, a frame or a few old.
+  const Eigen::Vector3d prior_c = q_w_c.toRotationMatrix().transpose() * Eigen::Vector3d::UnitZ();
+  health.vertical_calls.fetch_add(1, std::memory_order_relaxed);
+  const Expected<vertical::VerticalMeasurement> m = vertical_.estimate(query.images->left, prior_c);
+  if (!m) {
+    health.vertical_errors.fetch_add(1, std::memory_order_relaxed);  // the image is refused
+    return;
+  }
+  if (!m->valid || !m->up_c.allFinite() || !std::isfinite(m->sigma_rad)) return;
+  health.vertical_valid.fetch_add(1, std::memory_order_relaxed);
+  res.has_up = true;
+  for (int i = 0; i < 3; ++i) res.up_c[i] = m->up_c[i];
+  res.up_sigma = m->sigma_rad;
+}
+
+void SunStage::run() {
+  Channels& ch = ctx_.channels;
   for (;;) {
     const std::uint32_t key = ch.sun_requests_ev.prepare();
     SunRequest req;
@@ -26,37 +81,14 @@ void SunStage::run() {
     SunResult res;
     res.sequence = req.sequence;
     res.utc_ns = req.utc_ns;
-    auto sp = sun::computeSolarPosition(req.utc_ns, spa);
     SunQuery query;
     query.sequence = req.sequence;
     query.source_index = req.source_index;
     query.utc_ns = req.utc_ns;
     if (req.image_slot != kNoImage) query.images = &ctx_.sun_pool->slot(req.image_slot).frame;
-    Eigen::Quaterniond q_w_c_now;
-    if (sp && attitude_.latest(&q_w_c_now)) {
-      // Prior in the camera: sun_c = R_c_w sun_w, up_c = R_c_w (0, 0, 1) with ENU world (z up).
-      // The attitude is the last published pose's, one or a few frames before this one.
-      const Eigen::Matrix3d R_c_w = q_w_c_now.toRotationMatrix().transpose();
-      sunfusion::SunPrior prior;
-      prior.sun_c = (R_c_w * sp->sun_enu).normalized();
-      prior.up_c = R_c_w * Eigen::Vector3d::UnitZ();
-      query.prior = prior;
-    }
-    auto m = provider_->measure(query);
+    if (provider_) measureSun(query, res);
+    if (cue_) measureUp(query, res);
     if (req.image_slot != kNoImage) ctx_.sun_pool->release(req.image_slot);
-    if (!sp || !m) {
-      health.sun_errors.fetch_add(1, std::memory_order_relaxed);
-    } else if (m->has_value()) {
-      const sunfusion::SunMeasurement& meas = **m;
-      res.has_measurement = meas.sun_c.allFinite();
-      res.azimuth_only = meas.kind == sunfusion::SunMeasurementKind::kAzimuthOnly;
-      res.sigma = meas.sigma;
-      for (int i = 0; i < 3; ++i) {
-        res.sun_c[i] = meas.sun_c[i];
-        res.sun_w[i] = sp->sun_enu[i];
-      }
-      if (res.has_measurement) health.sun_measurements.fetch_add(1, std::memory_order_relaxed);
-    }
     ch.sun_results.push(res);
     ch.sun_results_ev.notify();
     ctx_.profiler.stamp(req.sequence, runtime::Stamp::kSunEnd, runtime::monotonicNs());

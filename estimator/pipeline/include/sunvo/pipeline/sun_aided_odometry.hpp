@@ -46,6 +46,10 @@ namespace sunvo::pipeline {
 struct VerticalCueOptions {
   bool enabled = false;  // measure "up" from the left image on the every-n frames (images only)
   vertical::VerticalOptions estimator;
+  // Not a config key: false when the caller measures "up" itself and gives it through
+  // addVertical() (sunvo_rover does, in its sun thread: the cue allocates, the estimator's loop
+  // must not). The fusion's vertical channel stays on either way.
+  bool measure_here = true;
   template <class Self, class V>
   static void fields(Self& s, V& v) {
     v("enabled", s.enabled);
