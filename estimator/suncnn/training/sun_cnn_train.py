@@ -240,6 +240,9 @@ def main():
                     help="3x3 convs in each of the trunk's last three stages")
     ap.add_argument("--crop-min", type=float, default=0.75,
                     help="smallest random crop, share of each side")
+    ap.add_argument("--loss-weight", choices=("scored", "horizontal"), default="scored",
+                    help="training frames' loss weight: 1 where the azimuth is scored, or that "
+                         "times the horizontal share of the sun direction")
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--seed", type=int, default=20261125)
     ap.add_argument("--first-member", type=int, default=0,
@@ -262,6 +265,11 @@ def main():
         raise SystemExit(f"{a.manifest}: no training rows")
     xtr, sun_tr, _ = data["train"]
     ttr, wtr = targets(sun_tr)
+    if a.loss_weight == "horizontal":
+        # How well an image defines the azimuth: shadows shorten and the sky's azimuthal
+        # gradient fades as the sun climbs, so a frame counts by the horizontal share of the sun
+        # direction (cos of its angle above the camera's x-z plane).
+        wtr = wtr * np.hypot(sun_tr[:, 0], sun_tr[:, 2]).astype(np.float32)
     log(f"loaded {sum(len(v[0]) for v in data.values())} images in {time.time() - t0:.0f} s")
     t_train = time.time()
     if a.load_members:
