@@ -57,8 +57,7 @@ void CaptureStage::run() {
     slot.meta.grab_mono_ns = grabbed;
     ctx_.profiler.stamp(ev.sequence, runtime::Stamp::kGrabEnd, grabbed);
     health.frames_grabbed.fetch_add(1, std::memory_order_relaxed);
-    const bool cue = schedule_.options().vertical.enabled && schedule_.isCueFrame(ev.sequence);
-    if (schedule_.isSunFrame(ev.sequence) || cue) requestSun(slot, ev.sequence, ev.utc_ns);
+    if (schedule_.isAidFrame(ev.sequence)) requestSun(slot, ev.sequence, ev.utc_ns);
 
     FrameTicket dropped;
     bool did_drop = false;

@@ -138,8 +138,7 @@ void EstimatorStage::run() {
     // (the window, size 2, keeps the frame's rotation free only while it is the newest).
     bool got = false;
     takeSunResults(seq, &got);
-    const bool cue_frame = cue && odometry_.isCueFrame(seq);
-    if ((odometry_.isSunFrame(seq) || cue_frame) && !got) {
+    if (odometry_.isAidFrame(seq) && !got) {
       const TimeNs until = runtime::monotonicNs() + sun_wait_ns;
       for (;;) {
         const std::uint32_t skey = ch.sun_results_ev.prepare();

@@ -17,6 +17,7 @@
 #include "sunvo/runtime/allocation_meter.hpp"
 #include "sunvo/runtime/frame_pool.hpp"
 #include "sunvo/runtime/latency_profiler.hpp"
+#include "sunvo/sun/spa.hpp"
 #include "sunvo/vertical/vertical_estimator.hpp"
 
 namespace sunvo::rover {
@@ -49,7 +50,7 @@ class CaptureStage {
   StageContext& ctx_;
   TriggerSource& trigger_;
   FrameSource& source_;
-  // Only its immutable every-n schedule is read here (isSunFrame is safe across threads).
+  // Only its immutable every-n schedule is read here (isAidFrame is safe across threads).
   const pipeline::SunAidedOdometry& schedule_;
   runtime::AllocationMeter meter_;
 };
@@ -100,8 +101,9 @@ class SunStage {
   runtime::AllocationMeter& meter() { return meter_; }
 
  private:
-  // The provider's sun (with the prior from the last published attitude and the ephemeris).
-  void measureSun(SunQuery& query, SunResult& res);
+  // The provider's sun (with the prior from the last published attitude and the ephemeris at
+  // the origin, `spa`).
+  void measureSun(const sun::SpaOptions& spa, SunQuery& query, SunResult& res);
   // The cue on the request's left image, with the last published attitude as its prior.
   void measureUp(const SunQuery& query, SunResult& res);
 

@@ -11,12 +11,8 @@ Status SunStage::initVerticalCue(const vertical::VerticalOptions& options,
   return Status::ok();
 }
 
-void SunStage::measureSun(SunQuery& query, SunResult& res) {
+void SunStage::measureSun(const sun::SpaOptions& spa, SunQuery& query, SunResult& res) {
   Health& health = ctx_.health;
-  sun::SpaOptions spa;
-  spa.latitude_deg = origin_.lat_deg;
-  spa.longitude_deg = origin_.lon_deg;
-  spa.elevation_m = origin_.alt_m;
   auto sp = sun::computeSolarPosition(query.utc_ns, spa);
   Eigen::Quaterniond q_w_c_now;
   if (sp && attitude_.latest(&q_w_c_now)) {
@@ -66,6 +62,10 @@ void SunStage::measureUp(const SunQuery& query, SunResult& res) {
 
 void SunStage::run() {
   Channels& ch = ctx_.channels;
+  sun::SpaOptions spa;
+  spa.latitude_deg = origin_.lat_deg;
+  spa.longitude_deg = origin_.lon_deg;
+  spa.elevation_m = origin_.alt_m;
   for (;;) {
     const std::uint32_t key = ch.sun_requests_ev.prepare();
     SunRequest req;
@@ -86,7 +86,7 @@ void SunStage::run() {
     query.source_index = req.source_index;
     query.utc_ns = req.utc_ns;
     if (req.image_slot != kNoImage) query.images = &ctx_.sun_pool->slot(req.image_slot).frame;
-    if (provider_) measureSun(query, res);
+    if (provider_) measureSun(spa, query, res);
     if (cue_) measureUp(query, res);
     if (req.image_slot != kNoImage) ctx_.sun_pool->release(req.image_slot);
     ch.sun_results.push(res);

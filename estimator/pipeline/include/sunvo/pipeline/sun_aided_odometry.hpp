@@ -98,6 +98,11 @@ class SunAidedOdometry {
   bool isCueFrame(std::uint64_t sequence) const {
     return sequence > 0 && sequence % static_cast<std::uint64_t>(options_.every_n_frames) == 0;
   }
+  // The frames that get an absolute direction: the sun's (isSunFrame) or, with vertical.enabled,
+  // the cue's. What a caller that measures them itself (vertical.measure_here false) asks for.
+  bool isAidFrame(std::uint64_t sequence) const {
+    return isSunFrame(sequence) || (options_.vertical.enabled && isCueFrame(sequence));
+  }
   // A measurement in camera k (observation.measurement.sequence = k) with the sun in the world.
   // Ignored (counted in sunOffered() only) when the sun is off.
   void addSun(const sunfusion::SunObservation& observation);
