@@ -251,9 +251,10 @@ std::span<const std::string_view> enumNames(SunProviderType) {
 pipeline::SunAidedOptions roverEstimatorDefaults() {
   pipeline::SunAidedOptions o;
   o.pipeline.vo.window.max_solver_time_in_seconds = 0.040;
-  o.fusion.max_drift_deg_per_frame = 0.01;
-  o.fusion.sun_bias_sigma_deg = 30.0;  // docs/fusion_bias.md, "Sources biased for a whole drive"
-  o.fusion.sun_bias_length_frames = 2500.0;
+  using Image = sunfusion::ImageEstimatorFusion;  // the rover's sun comes from the images
+  o.fusion.max_drift_deg_per_frame = Image::kMaxDriftDegPerFrame;
+  o.fusion.sun_bias_sigma_deg = Image::kSunBiasSigmaDeg;
+  o.fusion.sun_bias_length_frames = Image::kSunBiasLengthFrames;
   return o;
 }
 

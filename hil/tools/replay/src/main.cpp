@@ -72,12 +72,9 @@ int main(int argc, char** argv) {
   app.add_option("--image-max-drift-deg", options.image_max_drift_deg_per_frame,
                  "the same for the image estimators")
       ->check(CLI::Range(0.0, 5.0));
-  app.add_option("--image-bias-state-deg", options.image_sun_bias_sigma_deg,
-                 "the image estimators' azimuth bias state: its std, deg (0 = none)")
-      ->check(CLI::Range(0.0, 45.0));
-  app.add_option("--image-bias-state-frames", options.image_sun_bias_length_frames,
-                 "its correlation length, frames")
-      ->check(CLI::Range(1.0, 1e6));
+  sunvo::cli::addBiasStateOptions(
+      app, options.image_sun_bias_sigma_deg, options.image_sun_bias_length_frames, "image-",
+      "the image estimators' azimuth bias state: its std, deg (0 = none)");
   sunvo::cli::addBiasStateOptions(app, options.fusion);
   app.add_option("--max-bad-frames", options.max_consecutive_bad_frames,
                  "bad frames (missing or corrupt image) dropped in a row before the run stops; "

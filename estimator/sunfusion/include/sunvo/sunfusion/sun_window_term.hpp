@@ -213,6 +213,26 @@ struct SunFusionOptions {
   }
 };
 
+// The fusion's settings for an image sun estimator (Sun-CNN, Lalonde, Lalonde-VO), whose errors
+// stay alike for a street and can be biased for a whole drive; sunvo_replay's image-estimator
+// options and the rover's estimator defaults start from these.
+struct ImageEstimatorFusion {
+  // Cap of the adapted attitude random walk, deg/frame: the persistence test reads a street-long
+  // stretch of the estimator's error as a drift. 0.01 is the walk's start value: on the three
+  // benchmark drives Sun-CNN made VO worse by up to +246 % rot. ARMSE with 0.05, and by at most
+  // +0.5 % with 0.01 (docs/sun_estimators.md).
+  static constexpr double kMaxDriftDegPerFrame = 0.01;
+  // The azimuth bias state (sun_bias_sigma_deg, sun_bias_length_frames; docs/fusion_bias.md,
+  // "Sources biased for a whole drive"): an estimator that meets a look it was not trained on can
+  // be wrong by the same tens of degrees for a whole drive (the Sun-CNN ran at -66 deg on a
+  // foreign generator's drive, issue 14), and without the state the fusion follows it (+80 ...
+  // +2900 % final drift with a -30 or -66 deg offset on the simulated routes). 30 deg puts such
+  // an offset within about 2 sigma; 2500 frames (about 4 min at 10 Hz) is a drive's look, longer
+  // than a street.
+  static constexpr double kSunBiasSigmaDeg = 30.0;
+  static constexpr double kSunBiasLengthFrames = 2500.0;
+};
+
 class SunWindowTerm {
  public:
   Status init(const SunFusionOptions& options);

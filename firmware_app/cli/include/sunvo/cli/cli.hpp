@@ -63,17 +63,24 @@ void addRotationRatePriorOptions(CLI::App& app, WindowOptions& win) {
       ->check(CLI::Range(1e-3, 180.0));
 }
 
+// A sun azimuth bias state's std (deg) and correlation length (frames) as --<prefix>bias-state-deg
+// and --<prefix>bias-state-frames, with the fusion's ranges; `std_help` describes the std.
+inline void addBiasStateOptions(CLI::App& app, double& sigma_deg, double& length_frames,
+                                const std::string& prefix, const std::string& std_help) {
+  app.add_option("--" + prefix + "bias-state-deg", sigma_deg, std_help)
+      ->check(CLI::Range(0.0, 45.0));
+  app.add_option("--" + prefix + "bias-state-frames", length_frames,
+                 "its correlation length, frames")
+      ->check(CLI::Range(1.0, 1e6));
+}
+
 // The fusion's sun azimuth bias state (sunfusion::SunFusionOptions, docs/fusion_bias.md), the same
 // in every program that runs the fusion: --bias-state-deg, --bias-state-frames.
 template <class FusionOptions>
 void addBiasStateOptions(CLI::App& app, FusionOptions& fusion) {
-  app.add_option("--bias-state-deg", fusion.sun_bias_sigma_deg,
-                 "the fusion's sun azimuth bias state: its std, deg (0 = none; the true vector "
-                 "runs without it)")
-      ->check(CLI::Range(0.0, 45.0));
-  app.add_option("--bias-state-frames", fusion.sun_bias_length_frames,
-                 "its correlation length, frames")
-      ->check(CLI::Range(1.0, 1e6));
+  addBiasStateOptions(app, fusion.sun_bias_sigma_deg, fusion.sun_bias_length_frames, "",
+                      "the fusion's sun azimuth bias state: its std, deg (0 = none; the true "
+                      "vector runs without it)");
 }
 
 // The stereo self-calibration's drift rate (selfcal::StereoSelfCalibrationOptions,

@@ -41,22 +41,13 @@ struct ReplayOptions {
     f.initial_attitude_sigma_deg = 0.1;
     return f;
   }();
-  // Cap of the adapted attitude random walk for the image estimators, deg/frame,
-  // [fusion.min_drift_deg_per_frame, 5]; the error-model sources use
-  // fusion.max_drift_deg_per_frame. An image estimator's error is correlated along a street (the
-  // same scene for many frames), and the persistence test reads such a stretch as a drift. 0.01 is
-  // the random walk's start value: on the three benchmark drives Sun-CNN made VO worse by up to
-  // +246 % rot. ARMSE with 0.05, and by at most +0.5 % with 0.01 (docs/sun_estimators.md).
-  double image_max_drift_deg_per_frame = 0.01;
-  // The image estimators' azimuth error as a state of the fusion (fusion.sun_bias_sigma_deg and
-  // sun_bias_length_frames, docs/fusion_bias.md "Sources biased for a whole drive"): an estimator
-  // that meets a look it was not trained on can be wrong by the same tens of degrees for a whole
-  // drive (the Sun-CNN ran at -66 deg on a foreign generator's drive, issue 14), and without the
-  // state the fusion follows it (+80 ... +2900 % final drift with a -30 or -66 deg offset on the
-  // simulated routes). 30 deg puts such an offset within about 2 sigma; 2500 frames (about 4 min
-  // at 10 Hz) is a drive's look, longer than a street. Std deg [0, 45], 0 = none; frames [1, 1e6].
-  double image_sun_bias_sigma_deg = 30.0;
-  double image_sun_bias_length_frames = 2500.0;
+  // The image estimators' fusion settings (sunfusion::ImageEstimatorFusion says why); the
+  // error-model sources use `fusion`'s. Cap of the adapted attitude random walk, deg/frame,
+  // [fusion.min_drift_deg_per_frame, 5]; the azimuth bias state's std, deg [0, 45] (0 = none), and
+  // correlation length, frames [1, 1e6].
+  double image_max_drift_deg_per_frame = sunfusion::ImageEstimatorFusion::kMaxDriftDegPerFrame;
+  double image_sun_bias_sigma_deg = sunfusion::ImageEstimatorFusion::kSunBiasSigmaDeg;
+  double image_sun_bias_length_frames = sunfusion::ImageEstimatorFusion::kSunBiasLengthFrames;
   // Bad frames in a row that are dropped before the run stops with the last one's error, frames,
   // [0, 100000]; 0 = the first bad frame stops the run (and open() needs every image file).
   int max_consecutive_bad_frames = 10;
