@@ -145,6 +145,28 @@ TEST(VerticalOptionsTest, ValidationNamesTheKey) {
   o = VerticalOptions{};
   o.min_inliers = 2;
   EXPECT_NE(o.validate().message().find("vertical.min_inliers"), std::string::npos);
+  o = VerticalOptions{};
+  o.min_gradient = 0.0;
+  EXPECT_NE(o.validate().message().find("vertical.min_gradient"), std::string::npos);
+  o = VerticalOptions{};
+  o.max_segments = 8;
+  EXPECT_NE(o.validate().message().find("vertical.max_segments"), std::string::npos);
+}
+
+// The default detector (edge chains) and the baseline (LSD) find the same up on the same street.
+TEST_F(VerticalEstimatorTest, BothSegmentDetectorsAgree) {
+  const Eigen::Matrix3d C_c_w = expSO3(Eigen::Vector3d(1.5 * kDeg, 0.0, -2.5 * kDeg));
+  const Eigen::Vector3d up_true = C_c_w * Eigen::Vector3d(0.0, -1.0, 0.0);
+  const cv::Mat img = street(C_c_w, -15.0, 15.0, 30);
+  for (const SegmentDetector d : {SegmentDetector::kEdgeChains, SegmentDetector::kLsd}) {
+    VerticalOptions o;
+    o.detector = d;
+    VerticalEstimator est;
+    ASSERT_TRUE(est.init(o, kittiCamera()).isOk());
+    auto m = est.estimate(img, Eigen::Vector3d(0.0, -1.0, 0.0));
+    ASSERT_TRUE(m && m->valid) << static_cast<int>(d);
+    EXPECT_LT(std::acos(std::min(1.0, m->up_c.dot(up_true))) / kDeg, 0.15) << static_cast<int>(d);
+  }
 }
 
 }  // namespace

@@ -41,6 +41,12 @@ Status VerticalOptions::validate() const {
   if (max_width_px < 64 || max_width_px > 100000) {
     return invalidArgument("vertical.max_width_px out of range [64, 100000]");
   }
+  if (!(min_gradient > 0.0 && min_gradient <= 255.0)) {
+    return invalidArgument("vertical.min_gradient out of range (0, 255]");
+  }
+  if (max_segments < 16 || max_segments > 100000) {
+    return invalidArgument("vertical.max_segments out of range [16, 100000]");
+  }
   return Status::ok();
 }
 
@@ -49,9 +55,16 @@ Status VerticalEstimator::init(const VerticalOptions& options, const StereoCamer
   SUNVO_RETURN_IF_ERROR(camera.validate());
   options_ = options;
   camera_ = camera;
-  lsd_ = cv::createLineSegmentDetector(cv::LSD_REFINE_STD);
-  segments_.reserve(4096);
-  planes_.reserve(4096);
+  ready_ = false;
+  if (options.detector == SegmentDetector::kLsd) {
+    lsd_ = cv::createLineSegmentDetector(cv::LSD_REFINE_STD);
+  } else {
+    SUNVO_RETURN_IF_ERROR(chains_.init(camera.width, camera.height, options.max_width_px,
+                                       options.min_gradient, options.max_segments));
+  }
+  segments_.reserve(static_cast<std::size_t>(options.max_segments));
+  planes_.reserve(static_cast<std::size_t>(options.max_segments));
+  ready_ = true;
   return Status::ok();
 }
 
@@ -88,7 +101,7 @@ bool VerticalEstimator::refine(double bound, Eigen::Vector3d* up, int* inliers,
 
 Expected<VerticalMeasurement> VerticalEstimator::estimate(const cv::Mat& gray,
                                                           const Eigen::Vector3d& up_prior_c) {
-  if (!lsd_) return failedPrecondition("VerticalEstimator::estimate before init");
+  if (!ready_) return failedPrecondition("VerticalEstimator::estimate before init");
   if (gray.empty() || gray.type() != CV_8UC1) {
     return invalidArgument("vertical: image must be 8-bit single-channel (CV_8UC1), got type " +
                            std::to_string(gray.type()) + " with " +
@@ -108,7 +121,9 @@ Expected<VerticalMeasurement> VerticalEstimator::estimate(const cv::Mat& gray,
 
   // Scale of the detector's image per axis (its size is rounded, so sx and sy differ slightly).
   double sx = 1.0, sy = 1.0;
-  if (gray.cols > options_.max_width_px) {
+  if (options_.detector == SegmentDetector::kEdgeChains) {
+    SUNVO_RETURN_IF_ERROR(chains_.detect(gray, options_.min_segment_px, &segments_));
+  } else if (gray.cols > options_.max_width_px) {
     const double s = static_cast<double>(options_.max_width_px) / gray.cols;
     cv::resize(gray, small_, cv::Size(), s, s, cv::INTER_AREA);
     sx = static_cast<double>(small_.cols) / gray.cols;
@@ -129,6 +144,7 @@ Expected<VerticalMeasurement> VerticalEstimator::estimate(const cv::Mat& gray,
                            1.0);
   };
   for (const cv::Vec4f& seg : segments_) {
+    if (planes_.size() == planes_.capacity()) break;  // fixed memory: max_segments planes
     const Eigen::Vector2d a = full(seg[0], seg[1]), b = full(seg[2], seg[3]);
     const double len = (b - a).norm();
     if (!(len >= options_.min_segment_px)) continue;
