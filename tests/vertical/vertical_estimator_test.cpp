@@ -146,6 +146,9 @@ TEST(VerticalOptionsTest, ValidationNamesTheKey) {
   o.min_inliers = 2;
   EXPECT_NE(o.validate().message().find("vertical.min_inliers"), std::string::npos);
   o = VerticalOptions{};
+  o.min_segment_rows_share = 1.5;
+  EXPECT_NE(o.validate().message().find("vertical.min_segment_rows_share"), std::string::npos);
+  o = VerticalOptions{};
   o.min_gradient = 0.0;
   EXPECT_NE(o.validate().message().find("vertical.min_gradient"), std::string::npos);
   o = VerticalOptions{};

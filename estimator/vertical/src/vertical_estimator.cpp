@@ -20,8 +20,8 @@ Status VerticalOptions::validate() const {
   if (!(inlier_angle_deg > 0.0 && inlier_angle_deg <= 10.0)) {
     return invalidArgument("vertical.inlier_angle_deg out of range (0, 10]");
   }
-  if (!(min_segment_px >= 5.0 && min_segment_px <= 2000.0)) {
-    return invalidArgument("vertical.min_segment_px out of range [5, 2000]");
+  if (!(min_segment_rows_share > 0.0 && min_segment_rows_share <= 1.0)) {
+    return invalidArgument("vertical.min_segment_rows_share out of range (0, 1]");
   }
   if (min_inliers < 3 || min_inliers > 10000) {
     return invalidArgument("vertical.min_inliers out of range [3, 10000]");
@@ -119,10 +119,12 @@ Expected<VerticalMeasurement> VerticalEstimator::estimate(const cv::Mat& gray,
   VerticalMeasurement out;
   out.up_c = prior;
 
+  const double min_segment_px = options_.min_segment_rows_share * camera_.height;
   // Scale of the detector's image per axis (its size is rounded, so sx and sy differ slightly).
+  // The edge chains come in full-resolution pixels already: sx = sy = 1.
   double sx = 1.0, sy = 1.0;
   if (options_.detector == SegmentDetector::kEdgeChains) {
-    SUNVO_RETURN_IF_ERROR(chains_.detect(gray, options_.min_segment_px, &segments_));
+    SUNVO_RETURN_IF_ERROR(chains_.detect(gray, min_segment_px, &segments_));
   } else if (gray.cols > options_.max_width_px) {
     const double s = static_cast<double>(options_.max_width_px) / gray.cols;
     cv::resize(gray, small_, cv::Size(), s, s, cv::INTER_AREA);
@@ -147,7 +149,7 @@ Expected<VerticalMeasurement> VerticalEstimator::estimate(const cv::Mat& gray,
     if (planes_.size() == planes_.capacity()) break;  // fixed memory: max_segments planes
     const Eigen::Vector2d a = full(seg[0], seg[1]), b = full(seg[2], seg[3]);
     const double len = (b - a).norm();
-    if (!(len >= options_.min_segment_px)) continue;
+    if (!(len >= min_segment_px)) continue;
     const Eigen::Vector3d n = ray(a).cross(ray(b));
     const double norm = n.norm();
     if (!(norm > 0.0) || !n.allFinite()) continue;

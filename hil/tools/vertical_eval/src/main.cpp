@@ -58,7 +58,8 @@ int main(int argc, char** argv) {
                  "wider images are downscaled to this width first, px");
   app.add_option("--inlier-angle-deg", options.inlier_angle_deg, "inlier bound, deg");
   app.add_option("--line-sigma-deg", options.line_sigma_deg, "one segment's angle error, deg");
-  app.add_option("--min-segment-px", options.min_segment_px, "shortest segment, px");
+  app.add_option("--min-segment-rows-share", options.min_segment_rows_share,
+                 "shortest segment, as a share of the image's rows");
   std::string detector = "edge_chains";
   app.add_option("--detector", detector, "segment detector (default edge_chains)")
       ->check(CLI::IsMember({"edge_chains", "lsd"}));

@@ -53,14 +53,17 @@ inline std::span<const std::string_view> enumNames(SegmentDetector) {
 struct VerticalOptions {
   double max_tilt_deg = 15.0;     // deg, (0, 60]: candidates' planes within this of the prior up
   double inlier_angle_deg = 0.5;  // deg, (0, 10]: |n . u| bound of an inlier
-  double min_segment_px = 20.0;   // px at full resolution, [5, 2000]: shorter segments unused
-  int min_inliers = 8;            // [3, 10000]: fewer inliers = invalid
-  double max_sigma_deg = 3.0;     // deg, (0, 90]: a larger sigma = invalid
-  double min_sigma_deg = 0.2;     // deg, (0, 10]: floor of the reported sigma
-  double line_sigma_deg = 1.0;    // deg, (0, 10]: error of one segment's plane angle
-  int ransac_iterations = 300;    // [1, 100000]
-  std::uint32_t seed = 1;         // RANSAC's sampler, reset per call: same image, same answer
-  int max_width_px = 640;         // px, [64, 100000]: wider images are downscaled to it first
+  // (0, 1]: segments shorter than this share of the image's rows are unused (0.1: 37.5 px of
+  // a 375-row image). A share, not pixels, so the same scene content counts at any resolution;
+  // short edges carried a pitch bias on the validation drives (docs/vertical.md).
+  double min_segment_rows_share = 0.1;
+  int min_inliers = 8;          // [3, 10000]: fewer inliers = invalid
+  double max_sigma_deg = 3.0;   // deg, (0, 90]: a larger sigma = invalid
+  double min_sigma_deg = 0.2;   // deg, (0, 10]: floor of the reported sigma
+  double line_sigma_deg = 1.0;  // deg, (0, 10]: error of one segment's plane angle
+  int ransac_iterations = 300;  // [1, 100000]
+  std::uint32_t seed = 1;       // RANSAC's sampler, reset per call: same image, same answer
+  int max_width_px = 640;       // px, [64, 100000]: wider images are downscaled to it first
   SegmentDetector detector = SegmentDetector::kEdgeChains;  // edge_chains | lsd
   double min_gradient = 5.0;  // gray levels / px, (0, 255]: weakest edge (edge_chains only)
   int max_segments = 4096;    // [16, 100000]: segments kept per image (fixed memory)
@@ -70,7 +73,7 @@ struct VerticalOptions {
   static void fields(Self& s, V& v) {
     v("max_tilt_deg", s.max_tilt_deg);
     v("inlier_angle_deg", s.inlier_angle_deg);
-    v("min_segment_px", s.min_segment_px);
+    v("min_segment_rows_share", s.min_segment_rows_share);
     v("min_inliers", s.min_inliers);
     v("max_sigma_deg", s.max_sigma_deg);
     v("min_sigma_deg", s.min_sigma_deg);
