@@ -181,10 +181,8 @@ int main(int argc, char** argv) {
   auto sample = sunvo::bench::prepareBenchmark(g_config, sunvo::runtime::allocCounterActive());
   if (!sample) return sunvo::cli::fail(kProgram, sample.status());
   g_sample = std::move(*sample);
-  benchmark::RegisterBenchmark("frontend/kitti00_first_frames_pingpong", benchFrontend)
-      ->Iterations(g_config.frames)
-      ->Unit(benchmark::kMillisecond)
-      ->UseRealTime();
+  sunvo::bench::registerFrames("frontend/kitti00_first_frames_pingpong", g_config.frames,
+                               benchFrontend);
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
   printSummary();

@@ -127,14 +127,10 @@ int main(int argc, char** argv) {
   auto sample = sunvo::bench::prepareBenchmark(g_config, sunvo::runtime::allocCounterActive());
   if (!sample) return sunvo::cli::fail(kProgram, sample.status());
   g_sample = std::move(*sample);
-  benchmark::RegisterBenchmark("vertical/edge_chains", benchVertical, SegmentDetector::kEdgeChains)
-      ->Iterations(g_config.frames)
-      ->Unit(benchmark::kMillisecond)
-      ->UseRealTime();
-  benchmark::RegisterBenchmark("vertical/lsd", benchVertical, SegmentDetector::kLsd)
-      ->Iterations(g_config.frames)
-      ->Unit(benchmark::kMillisecond)
-      ->UseRealTime();
+  sunvo::bench::registerFrames("vertical/edge_chains", g_config.frames, benchVertical,
+                               SegmentDetector::kEdgeChains);
+  sunvo::bench::registerFrames("vertical/lsd", g_config.frames, benchVertical,
+                               SegmentDetector::kLsd);
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
   printSummary();

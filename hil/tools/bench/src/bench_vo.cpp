@@ -485,27 +485,18 @@ int main(int argc, char** argv) {
   g_full.name = "full";
   g_full_ceres.name = "full_ceres";
   g_ransac_only.name = "ransac_only";
-  benchmark::RegisterBenchmark("vo/full/kitti00_first_frames_pingpong", benchFull)
-      ->Iterations(g_config.frames)
-      ->Unit(benchmark::kMillisecond)
-      ->UseRealTime();
-  benchmark::RegisterBenchmark("vo/full_ceres/kitti00_first_frames_pingpong", benchFullCeres)
-      ->Iterations(g_config.frames)
-      ->Unit(benchmark::kMillisecond)
-      ->UseRealTime();
-  benchmark::RegisterBenchmark("vo/ransac_only/kitti00_first_frames_pingpong", benchRansacOnly)
-      ->Iterations(g_config.frames)
-      ->Unit(benchmark::kMillisecond)
-      ->UseRealTime();
+  sunvo::bench::registerFrames("vo/full/kitti00_first_frames_pingpong", g_config.frames, benchFull);
+  sunvo::bench::registerFrames("vo/full_ceres/kitti00_first_frames_pingpong", g_config.frames,
+                               benchFullCeres);
+  sunvo::bench::registerFrames("vo/ransac_only/kitti00_first_frames_pingpong", g_config.frames,
+                               benchRansacOnly);
   if (!g_config.tracks.empty()) {
     auto seq = sunvo::dataset::readTrackFolder(g_config.tracks, sunvo::files::TrackReadOptions{});
     if (!seq) return sunvo::cli::fail(kProgram, seq.status());
     g_track_seq = std::move(*seq);
     g_tracks.name = "tracks";
-    benchmark::RegisterBenchmark("vo/backend_only/kitti_tracks_0020", benchTracks)
-        ->Iterations(static_cast<benchmark::IterationCount>(g_track_seq.frames.size()))
-        ->Unit(benchmark::kMillisecond)
-        ->UseRealTime();
+    sunvo::bench::registerFrames("vo/backend_only/kitti_tracks_0020",
+                                 static_cast<int>(g_track_seq.frames.size()), benchTracks);
   }
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();

@@ -8,6 +8,7 @@
 
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "sunvo/cli/cli.hpp"
@@ -29,6 +30,16 @@ inline std::optional<int> parseWithBenchmarkFlags(CLI::App& app, int argc, char*
     return cli::kExitUsage;
   }
   return std::nullopt;
+}
+
+// Registers fn(state, args...) as a benchmark of exactly `frames` timed iterations, reported in
+// wall-clock milliseconds (every sunvo benchmark times a fixed number of frames).
+template <class Fn, class... Args>
+void registerFrames(const char* name, int frames, Fn&& fn, Args&&... args) {
+  benchmark::RegisterBenchmark(name, std::forward<Fn>(fn), std::forward<Args>(args)...)
+      ->Iterations(frames)
+      ->Unit(benchmark::kMillisecond)
+      ->UseRealTime();
 }
 
 }  // namespace sunvo::bench
