@@ -49,9 +49,10 @@ class VerticalSegmentDetector {
   // min_gradient: gray levels per pixel (> 0); max_segments: output capacity. Allocates.
   Status init(int width, int height, int max_width, double min_gradient, int max_segments);
 
-  // gray: CV_8UC1 of the init size. segments: cleared, then filled up to its capacity
-  // (reserved here at init: max_segments) with (x0, y0, x1, y1) in full-resolution pixels,
-  // y0 < y1. No allocation once segments has that capacity.
+  // gray: CV_8UC1 of the init size. segments: cleared, then filled with at most max_segments
+  // segments (x0, y0, x1, y1) in full-resolution pixels, y0 < y1; the rest are counted in
+  // stats().dropped_full. Reserved to max_segments on the first call if smaller; no allocation
+  // after that.
   Status detect(const cv::Mat& gray, double min_length_px, std::vector<cv::Vec4f>* segments);
 
   const VerticalSegmentStats& stats() const { return stats_; }
