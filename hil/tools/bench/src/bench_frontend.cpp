@@ -177,10 +177,9 @@ int main(int argc, char** argv) {
   CLI::App app{"Stereo front-end time and heap allocations per frame on real KITTI frames.",
                kProgram};
   sunvo::bench::addBenchOptions(app, g_config);
-  if (auto code = sunvo::bench::parseWithBenchmarkFlags(app, argc, argv)) return *code;
-  auto sample = sunvo::bench::prepareBenchmark(g_config, sunvo::runtime::allocCounterActive());
-  if (!sample) return sunvo::cli::fail(kProgram, sample.status());
-  g_sample = std::move(*sample);
+  if (auto code = sunvo::bench::startBenchmark(app, argc, argv, kProgram, g_config, &g_sample)) {
+    return *code;
+  }
   sunvo::bench::registerFrames("frontend/kitti00_first_frames_pingpong", g_config.frames,
                                benchFrontend);
   benchmark::RunSpecifiedBenchmarks();

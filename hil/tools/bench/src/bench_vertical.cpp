@@ -123,10 +123,9 @@ int main(int argc, char** argv) {
   CLI::App app{"Vertical cue: CPU time and heap allocations per call on real KITTI images.",
                kProgram};
   sunvo::bench::addBenchOptions(app, g_config);
-  if (auto code = sunvo::bench::parseWithBenchmarkFlags(app, argc, argv)) return *code;
-  auto sample = sunvo::bench::prepareBenchmark(g_config, sunvo::runtime::allocCounterActive());
-  if (!sample) return sunvo::cli::fail(kProgram, sample.status());
-  g_sample = std::move(*sample);
+  if (auto code = sunvo::bench::startBenchmark(app, argc, argv, kProgram, g_config, &g_sample)) {
+    return *code;
+  }
   sunvo::bench::registerFrames("vertical/edge_chains", g_config.frames, benchVertical,
                                SegmentDetector::kEdgeChains);
   sunvo::bench::registerFrames("vertical/lsd", g_config.frames, benchVertical,

@@ -478,10 +478,9 @@ int main(int argc, char** argv) {
             return sunvo::bench::peerUnavailableMessage(name);
           },
           "PEER", "built-in peer"));
-  if (auto code = sunvo::bench::parseWithBenchmarkFlags(app, argc, argv)) return *code;
-  auto data = sunvo::bench::prepareBenchmark(g_config, sunvo::runtime::allocCounterActive());
-  if (!data) return sunvo::cli::fail(kProgram, data.status());
-  g_data = std::move(*data);
+  if (auto code = sunvo::bench::startBenchmark(app, argc, argv, kProgram, g_config, &g_data)) {
+    return *code;
+  }
   g_full.name = "full";
   g_full_ceres.name = "full_ceres";
   g_ransac_only.name = "ransac_only";

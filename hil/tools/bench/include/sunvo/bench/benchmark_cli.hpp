@@ -11,7 +11,9 @@
 #include <utility>
 #include <vector>
 
+#include "sunvo/bench/bench_support.hpp"
 #include "sunvo/cli/cli.hpp"
+#include "sunvo/runtime/alloc_counter.hpp"
 
 namespace sunvo::bench {
 
@@ -29,6 +31,19 @@ inline std::optional<int> parseWithBenchmarkFlags(CLI::App& app, int argc, char*
   if (benchmark::ReportUnrecognizedArguments(bench_argc, bench_argv.data())) {
     return cli::kExitUsage;
   }
+  return std::nullopt;
+}
+
+// The start of every benchmark program, after its options were added to app (addBenchOptions
+// and its own): parses the command line, pins to config.cpu, checks the allocation counter and
+// loads config.data into *frames. nullopt: go on; else the exit code (usage, or the failure
+// named on stderr).
+inline std::optional<int> startBenchmark(CLI::App& app, int argc, char** argv, const char* program,
+                                         const BenchConfig& config, KittiFrames* frames) {
+  if (auto code = parseWithBenchmarkFlags(app, argc, argv)) return code;
+  auto loaded = prepareBenchmark(config, runtime::allocCounterActive());
+  if (!loaded) return cli::fail(program, loaded.status());
+  *frames = std::move(*loaded);
   return std::nullopt;
 }
 
