@@ -86,10 +86,9 @@ int main(int argc, char** argv) {
   app.add_flag("--vertical", vertical,
                "also a run with the vertical vanishing-point cue alone (\"VO+vertical\", no sun), "
                "and each image estimator once more with it");
-  std::string vertical_detector = "edge_chains";
-  app.add_option("--vertical-detector", vertical_detector,
-                 "the cue's segment detector (default edge_chains; lsd: OpenCV's, the baseline)")
-      ->check(CLI::IsMember({"edge_chains", "lsd"}));
+  sunvo::cli::addEnumOption(app, "--vertical-detector", options.vertical.estimator.detector,
+                            "the cue's segment detector (default edge_chains; lsd: OpenCV's, the "
+                            "baseline)");
   bool self_calib = false;
   app.add_flag("--self-calib", self_calib,
                "online stereo self-calibration of the right camera (measures the right rows); its "
@@ -170,9 +169,6 @@ int main(int argc, char** argv) {
   }
   sunvo::replay::ReplayOptions vertical_options = options;
   vertical_options.vertical.enabled = true;
-  if (vertical_detector == "lsd") {
-    vertical_options.vertical.estimator.detector = sunvo::vertical::SegmentDetector::kLsd;
-  }
   const Eigen::Vector3d up_w = data->worldUp();
   for (std::size_t i = 0; i < plan.size(); ++i) {
     const Planned& p = plan[i];

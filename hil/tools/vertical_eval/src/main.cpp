@@ -60,14 +60,11 @@ int main(int argc, char** argv) {
   app.add_option("--line-sigma-deg", options.line_sigma_deg, "one segment's angle error, deg");
   app.add_option("--min-segment-rows-share", options.min_segment_rows_share,
                  "shortest segment, as a share of the image's rows");
-  std::string detector = "edge_chains";
-  app.add_option("--detector", detector, "segment detector (default edge_chains)")
-      ->check(CLI::IsMember({"edge_chains", "lsd"}));
+  sunvo::cli::addEnumOption(app, "--detector", options.detector,
+                            "segment detector (default edge_chains; lsd: OpenCV's)");
   app.add_option("--min-gradient", options.min_gradient,
                  "weakest edge for edge_chains, gray levels / px");
   if (auto code = sunvo::cli::parse(app, argc, argv)) return *code;
-  options.detector = detector == "lsd" ? sunvo::vertical::SegmentDetector::kLsd
-                                       : sunvo::vertical::SegmentDetector::kEdgeChains;
   if (auto s = options.validate(); !s.isOk()) {
     std::fprintf(stderr, "%s: %s\n", kProgram, s.toString().c_str());
     return sunvo::cli::kExitUsage;

@@ -14,7 +14,9 @@
 #include <CLI/CLI.hpp>
 #include <optional>
 #include <string>
+#include <vector>
 
+#include "sunvo/core/fields.hpp"
 #include "sunvo/core/status.hpp"
 
 namespace sunvo::cli {
@@ -32,6 +34,25 @@ int fail(const std::string& program, const std::string& message);
 
 // The project version, e.g. "0.1.0".
 const char* version();
+
+// An option whose value is one of a named enum's names (enumNames, as the config files spell
+// them), e.g. --detector edge_chains|lsd; any other word is a usage error naming the option.
+template <NamedEnum E>
+CLI::Option* addEnumOption(CLI::App& app, const std::string& name, E& value,
+                           const std::string& help) {
+  const std::span<const std::string_view> names = enumNames(value);
+  std::vector<std::string> choices(names.begin(), names.end());
+  return app
+      .add_option_function<std::string>(
+          name,
+          [&value, names](const std::string& word) {
+            for (std::size_t i = 0; i < names.size(); ++i) {
+              if (names[i] == word) value = static_cast<E>(i);
+            }
+          },
+          help)
+      ->check(CLI::IsMember(choices));
+}
 
 // The window's rotation-rate prior switches (backend::WindowOptions, docs/backend.md), the same
 // in every program that runs the back end: --no-rate-prior, --rate-prior-pitch/-yaw/-roll
