@@ -75,7 +75,7 @@ Expected<FrameResult> SunAidedOdometry::process(const StereoFrame& frame) {
   if (vertical_active_ && isCueFrame(frame.sequence)) {
     const auto t0 = std::chrono::steady_clock::now();
     // The prior: "up" in the last frame's camera (one frame of motion away from this one).
-    const Eigen::Vector3d up_w = options_.fusion.world_up;
+    const Eigen::Vector3d up_w = sun_term_.worldUp();  // aligned, when the world has no gravity
     const Eigen::Vector3d prior_c = T_w_c_.linear().transpose() * up_w;
     ++vertical_stats_.calls;
     Expected<vertical::VerticalMeasurement> m = vertical_.estimate(frame.left, prior_c);

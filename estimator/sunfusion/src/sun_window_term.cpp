@@ -46,6 +46,9 @@ Status SunFusionOptions::validate() const {
   if (!world_up.allFinite() || std::abs(world_up.norm() - 1.0) > 1e-6) {
     return invalidArgument("fusion.world_up must be a unit vector");
   }
+  if (!(world_up_alignment_frames >= 0 && world_up_alignment_frames <= 100000)) {
+    return invalidArgument("fusion.world_up_alignment_frames out of range [0, 100000]");
+  }
   if (!(loss_scale >= 0.0 && loss_scale <= 100.0)) {
     return invalidArgument("fusion.loss_scale out of range [0, 100]");
   }
@@ -138,6 +141,7 @@ Status SunWindowTerm::init(const SunFusionOptions& options) {
   num_corrections_ = 0;
   last_nis_ = 0.0;
   num_inflations_ = 0;
+  world_up_.reset(static_cast<std::uint64_t>(options.world_up_alignment_frames), options.world_up);
   // Every cost a slot can need, in the form the options ask for (the only allocations).
   const SunResidualForm form = !options.estimate_base_attitude ? SunResidualForm::kPaper
                                : biasEnabled() ? SunResidualForm::kBaseCorrectionAndBias
@@ -218,15 +222,28 @@ Status SunWindowTerm::onSolve(backend::BundleWindow& window) {
         static_cast<std::size_t>(channel);
     if (!used_[ring] || pending_[ring].obs.measurement.sequence != window.sequence(s)) continue;
     Pending& p = pending_[ring];
-    const Eigen::Vector3d sun_b = C_b_w * p.obs.sun_w;
+    // An undecided "up" of the first frames measures the world's up (world_up_alignment.hpp);
+    // the first one past them ends that, and is used with the estimate.
+    const bool aligning = channel == 1 && !p.decided && world_up_.takes(window.sequence(s));
+    const Eigen::Vector3d sun_w = channel == 0 ? p.obs.sun_w : world_up_.up();
+    const Eigen::Vector3d sun_b = C_b_w * sun_w;
     bool cost_built = false;  // p.cost already holds this solve's residual
     const bool bias_cost = with_bias && channel == 0;
     if (!p.decided) {
       Eigen::Vector3d predicted_c = window.T_k_b(s).linear() * sun_b;
       if (bias_cost) predicted_c = turnAboutCameraY(predicted_c, bias_);
-      const double up = p.obs.sun_w.dot(options_.world_up);
+      const double up = sun_w.dot(world_up_.up());
       GateResult r = gateSunMeasurement(channel == 0 ? options_.gate : options_.vertical_gate,
                                         predicted_c, up, p.obs.measurement);
+      if (aligning && r == GateResult::kAccepted) {
+        // up_w = C_w_b C_b_k up_k.
+        world_up_.add(window.T_w_b().linear() * window.T_k_b(s).linear().transpose() *
+                          p.obs.measurement.sun_c,
+                      p.obs.measurement.sigma);
+        p.decided = true;
+        p.accepted = false;
+        continue;
+      }
       if (r == GateResult::kAccepted && estimate) {
         p.cost = setSunCost(ring, sun_b, p.obs.measurement);
         cost_built = true;
@@ -376,7 +393,7 @@ void SunWindowTerm::propagate(double frames) {
     return;
   }
   // Tilt (the plane normal to the world's up) and heading (about it) walk apart.
-  const Eigen::Vector3d& u = options_.world_up;
+  const Eigen::Vector3d& u = world_up_.up();
   const double qh = heading_drift_deg_per_frame_ * kDeg;
   const Eigen::Matrix3d uu = u * u.transpose();
   P_ += (q * q * (Eigen::Matrix3d::Identity() - uu) + qh * qh * uu) * frames;

@@ -107,8 +107,8 @@ class SunAidedOdometry {
   // Ignored (counted in sunOffered() only) when the sun is off.
   void addSun(const sunfusion::SunObservation& observation);
   // An "up" measured by another source (an error model, an accelerometer at rest) for camera k:
-  // measurement.sun_c = up in camera k, sun_w = fusion.world_up. Used when vertical.enabled (with
-  // any input); ignored otherwise.
+  // measurement.sun_c = up in camera k (sun_w is not read: the world's up is worldUp()). Used
+  // when vertical.enabled (with any input); ignored otherwise.
   void addVertical(const sunfusion::SunObservation& observation);
 
   Expected<FrameResult> process(const StereoFrame& frame);     // kImages
@@ -120,6 +120,9 @@ class SunAidedOdometry {
   const sunfusion::GateCounters& sunCounters() const { return sun_term_.counters(); }
   const Eigen::Matrix3d& attitudeCovariance() const { return sun_term_.attitudeCovariance(); }
   const sunfusion::SunWindowTerm& sunTerm() const { return sun_term_; }
+  // The world's up: fusion.world_up, or its estimate from the first frames' "up" answers when
+  // fusion.world_up_alignment_frames > 0 (sun_window_term.hpp).
+  const Eigen::Vector3d& worldUp() const { return sun_term_.worldUp(); }
   std::uint64_t sunOffered() const { return sun_offered_; }
   // The vertical cue: active (enabled, image input), its gate counters, and the estimator's
   // calls, valid answers and input errors (a frame whose image it refused; the run goes on).
