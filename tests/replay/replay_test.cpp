@@ -216,5 +216,35 @@ TEST(Replay, ImageEstimatorBiasStateIsTheirsAndValidated) {
   EXPECT_NE(options.validate().message().find("sun_bias_length_frames"), std::string::npos);
 }
 
+// A KITTI odometry sequence's world is its first camera, whose tilt nobody measured: the replay
+// measures the world's up from the cue's first answers (docs/vertical.md) instead of taking the
+// first camera's -y, unless told otherwise. The 11 real frames give the cue two frames (5, 10),
+// both within the 50 frames of the alignment: they measure the up and correct nothing.
+TEST(Replay, AFirstCameraWorldAlignsItsUpFromTheCue) {
+  ReplayOptions options;
+  options.dataset.path = std::string(SUNVO_DATA_DIR) + "/kitti_odometry/00_first_frames";
+  options.pipeline.vo.window.max_solver_time_in_seconds = 10.0;
+  options.vertical.enabled = true;
+  auto data = openReplayDataset(options);
+  ASSERT_TRUE(data) << data.status().toString();
+  ASSERT_EQ(data->world(), dataset::WorldFrame::kFirstCamera);
+  auto aligned = replayDrive(*data, options, std::nullopt);
+  ASSERT_TRUE(aligned) << aligned.status().toString();
+  ASSERT_GE(aligned->vertical_stats.valid, 1u);
+  EXPECT_EQ(aligned->world_up_answers, static_cast<int>(aligned->vertical_stats.valid));
+  EXPECT_EQ(aligned->vertical_gate.accepted, 0u);
+  EXPECT_EQ(aligned->world_up, -Eigen::Vector3d::UnitY());  // fewer than 3 answers: not done
+
+  options.world_up_alignment_frames = 0;  // the first camera's -y is up
+  auto told = replayDrive(*data, options, std::nullopt);
+  ASSERT_TRUE(told) << told.status().toString();
+  EXPECT_EQ(told->world_up_answers, 0);
+  EXPECT_EQ(told->vertical_gate.accepted, told->vertical_stats.valid);
+
+  options.world_up_alignment_frames = -2;
+  EXPECT_NE(options.validate().message().find("replay.world_up_alignment_frames"),
+            std::string::npos);
+}
+
 }  // namespace
 }  // namespace sunvo::replay

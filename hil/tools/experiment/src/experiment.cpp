@@ -20,6 +20,10 @@ Status ExperimentOptions::validate() const {
   }
   if (max_frames < 0) return invalidArgument("experiment.max_frames must be >= 0");
   if (vertical) SUNVO_RETURN_IF_ERROR(vertical->validate());
+  if (!(std::abs(true_up_pitch_deg) <= 30.0 && std::abs(true_up_roll_deg) <= 30.0)) {
+    return invalidArgument(
+        "experiment.true_up_pitch_deg / true_up_roll_deg out of range [-30, 30]");
+  }
   return Status::ok();
 }
 
@@ -45,6 +49,11 @@ Expected<RunResult> runRoute(const Route& route, const std::optional<SunSourceSp
     SUNVO_RETURN_IF_ERROR(spec->model.validate());
     source.emplace(spec->model);
   }
+  const double kRad = M_PI / 180.0;
+  const Eigen::Vector3d true_up_w =
+      Eigen::AngleAxisd(options.true_up_roll_deg * kRad, Eigen::Vector3d::UnitZ()) *
+      (Eigen::AngleAxisd(options.true_up_pitch_deg * kRad, Eigen::Vector3d::UnitX()) *
+       route.world_up);
   std::optional<sunfusion::SimulatedVerticalSource> vertical;
   if (options.vertical) {
     sao.vertical.enabled = true;
@@ -67,7 +76,7 @@ Expected<RunResult> runRoute(const Route& route, const std::optional<SunSourceSp
       if (m) odometry.addSun({*m, route.sun_w[k]});
     }
     if (vertical && odometry.isCueFrame(frame.sequence)) {
-      const Eigen::Vector3d up_c = route.T_w_c_gt[k].linear().transpose() * route.world_up;
+      const Eigen::Vector3d up_c = route.T_w_c_gt[k].linear().transpose() * true_up_w;
       auto m = vertical->measure(frame.sequence, frame.time_ns, up_c);
       if (m) odometry.addVertical({*m, route.world_up});
     }
@@ -82,6 +91,9 @@ Expected<RunResult> runRoute(const Route& route, const std::optional<SunSourceSp
   }
   result.gate = odometry.sunCounters();
   result.vertical_gate = odometry.verticalCounters();
+  result.world_up_answers = odometry.sunTerm().worldUpAlignment().used();
+  result.world_up_error_deg =
+      std::acos(std::clamp(odometry.worldUp().dot(true_up_w), -1.0, 1.0)) / kRad;
   result.selfcal_pitch_mrad = odometry.lastSelfCalibration().pitch_mrad;
   result.selfcal_roll_mrad = odometry.lastSelfCalibration().roll_mrad;
   result.selfcal_resets = odometry.lastSelfCalibration().resets;
@@ -94,7 +106,7 @@ Expected<RunResult> runRoute(const Route& route, const std::optional<SunSourceSp
   auto ev = metrics::evaluate(gt, result.T_w_c, eval_opt);
   if (!ev) return ev.status();
   result.evaluation = *ev;
-  auto tilt = metrics::computeTilt(gt, result.T_w_c, route.world_up);
+  auto tilt = metrics::computeTilt(gt, result.T_w_c, true_up_w);
   if (!tilt) return tilt.status();
   result.tilt = *tilt;
   return result;

@@ -110,6 +110,18 @@ int main(int argc, char** argv) {
   app.add_option("--vertical-dropout", vertical_model.dropout_share,
                  "share of its frames without a measurement")
       ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--true-up-pitch-deg", options.true_up_pitch_deg,
+                 "the route's gravity turned from its first camera's -y about x, deg: what the "
+                 "simulated \"up\" measures (the fusion is told -y)")
+      ->check(CLI::Range(-30.0, 30.0));
+  app.add_option("--true-up-roll-deg", options.true_up_roll_deg, "the same about z, deg")
+      ->check(CLI::Range(-30.0, 30.0));
+  // The simulated "up" is the first camera's -y unless --true-up-* say otherwise, so by default
+  // there is nothing to align (sunvo_replay aligns a first-camera world's images by default).
+  app.add_option("--world-up-alignment-frames", options.fusion.world_up_alignment_frames,
+                 "the \"up\" answers of the first N frames measure the world's up (default 0: "
+                 "the first camera's -y is up; 50: sunvo_replay's for a first-camera world)")
+      ->check(CLI::Range(0, 100000));
   app.add_flag("--self-calib", self_calib,
                "online stereo self-calibration of the right camera before the odometry");
   sunvo::cli::addSelfCalibrationRateOptions(app, options.self_calibration);
@@ -250,6 +262,10 @@ int main(int argc, char** argv) {
       if (!run) return sunvo::cli::fail(kProgram, route->name + ": " + run.status().toString());
       std::fprintf(stderr, "  %-28s done (%.2f ms/frame median, %d lost)\n", run->name.c_str(),
                    run->median_ms, run->lost_frames);
+      if (run->world_up_answers > 0) {
+        std::fprintf(stderr, "    world's up from %d answers: %.3f deg from the true one\n",
+                     run->world_up_answers, run->world_up_error_deg);
+      }
       if (self_calib) {
         std::fprintf(stderr,
                      "    self-calibration: right camera roll %.4f mrad, pitch %.4f mrad, "

@@ -89,6 +89,10 @@ int main(int argc, char** argv) {
   sunvo::cli::addEnumOption(app, "--vertical-detector", options.vertical.estimator.detector,
                             "the cue's segment detector (default edge_chains; lsd: OpenCV's, the "
                             "baseline)");
+  app.add_option("--world-up-alignment-frames", options.world_up_alignment_frames,
+                 "the cue's answers of the first N frames measure the world's up (-1: 50 when the "
+                 "world is the first camera, which nobody levelled; 0 in ENU)")
+      ->check(CLI::Range(-1, 100000));
   bool self_calib = false;
   app.add_flag("--self-calib", self_calib,
                "online stereo self-calibration of the right camera (measures the right rows); its "
@@ -235,6 +239,13 @@ int main(int argc, char** argv) {
                    static_cast<unsigned long long>(run->vertical_stats.valid),
                    static_cast<unsigned long long>(run->vertical_gate.accepted),
                    static_cast<unsigned long long>(run->vertical_stats.errors));
+    }
+    if (run->world_up_answers > 0) {
+      std::fprintf(stderr,
+                   "  %-28s world's up (%.4f, %.4f, %.4f) from %d cue answers: %.3f deg off the "
+                   "assumed one\n",
+                   "", run->world_up.x(), run->world_up.y(), run->world_up.z(),
+                   run->world_up_answers, run->world_up_tilt_deg);
     }
     if (self_calib) {
       // Per frame: OUT/self_calibration_<run>.csv (the right camera's estimate after each frame).

@@ -13,6 +13,9 @@ Status ReplayOptions::validate() const {
   SUNVO_RETURN_IF_ERROR(pipeline.validate());
   SUNVO_RETURN_IF_ERROR(fusion.validate());
   SUNVO_RETURN_IF_ERROR(vertical.estimator.validate());
+  if (world_up_alignment_frames < -1 || world_up_alignment_frames > 100000) {
+    return invalidArgument("replay.world_up_alignment_frames out of range -1 or [0, 100000]");
+  }
   if (max_consecutive_bad_frames < 0 || max_consecutive_bad_frames > 100000) {
     return invalidArgument("replay.max_consecutive_bad_frames out of range [0, 100000]");
   }
@@ -83,6 +86,10 @@ Expected<ReplayRun> replayDrive(const dataset::Dataset& data, const ReplayOption
   sao.vertical = options.vertical;
   sao.fusion = image_sun != nullptr ? options.imageFusion() : options.fusion;
   sao.fusion.world_up = data.worldUp();
+  sao.fusion.world_up_alignment_frames =
+      options.world_up_alignment_frames >= 0              ? options.world_up_alignment_frames
+      : data.world() == dataset::WorldFrame::kFirstCamera ? sunfusion::kWorldUpAlignmentFrames
+                                                          : 0;
   std::optional<sunfusion::SimulatedSunSource> sun_source;
   if (spec) {
     sao.fusion.gate = spec->gate;
@@ -160,6 +167,9 @@ Expected<ReplayRun> replayDrive(const dataset::Dataset& data, const ReplayOption
   run.gate = vo.sunCounters();
   run.vertical_gate = vo.verticalCounters();
   run.vertical_stats = vo.verticalStats();
+  run.world_up_answers = vo.sunTerm().worldUpAlignment().used();
+  run.world_up_tilt_deg = vo.sunTerm().worldUpAlignment().tiltDeg();
+  run.world_up = vo.worldUp();
   run.median_ms = metrics::percentile(ms, 0.5);
   run.p99_ms = metrics::percentile(ms, 0.99);
   return run;

@@ -55,6 +55,12 @@ struct ExperimentOptions {
   // A simulated "up" measurement on the every-n frames of every run (the vertical cue's error
   // model; none by default). A pure-VO run with it is "VO+vertical-like".
   std::optional<sunfusion::VerticalErrorModel> vertical;
+  // Where the route's gravity truly is (what the simulated "up" measures): the first camera's -y
+  // turned about its x axis (pitch) then its z axis (roll), deg, [-30, 30]. The fusion is told -y
+  // (route.world_up); a real first camera is tilted by the road's camber and slope and the mount.
+  // 0, 0 = level.
+  double true_up_pitch_deg = 0.0;
+  double true_up_roll_deg = 0.0;
   // Online stereo self-calibration of the tracks before the odometry (off by default).
   selfcal::StereoSelfCalibrationOptions self_calibration;
   // Gate and world_up are set per source / route. VO starts at the ground-truth first pose, so the
@@ -73,6 +79,8 @@ struct RunResult {
   sunfusion::GateCounters gate;           // all zero for pure VO
   sunfusion::GateCounters vertical_gate;  // the vertical source's (when options.vertical)
   metrics::TiltMetrics tilt;              // attitude error split into tilt and heading
+  int world_up_answers = 0;               // "up" answers that measured the world's up (if aligned)
+  double world_up_error_deg = 0.0;  // angle of the world's up in use from the route's true one
   int lost_frames = 0;
   double median_ms = 0.0;  // VO time per frame (association, RANSAC, window), median
   double p99_ms = 0.0;

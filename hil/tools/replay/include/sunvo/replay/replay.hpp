@@ -48,6 +48,10 @@ struct ReplayOptions {
   double image_max_drift_deg_per_frame = sunfusion::ImageEstimatorFusion::kMaxDriftDegPerFrame;
   double image_sun_bias_sigma_deg = sunfusion::ImageEstimatorFusion::kSunBiasSigmaDeg;
   double image_sun_bias_length_frames = sunfusion::ImageEstimatorFusion::kSunBiasLengthFrames;
+  // fusion.world_up_alignment_frames for the drive, frames, -1 or [0, 100000]: -1 = by its world,
+  // sunfusion::kWorldUpAlignmentFrames when that is the first camera (KITTI odometry: no gravity
+  // in it), 0 in ENU (raw drives and renders: the first pose comes from the INS).
+  int world_up_alignment_frames = -1;
   // Bad frames in a row that are dropped before the run stops with the last one's error, frames,
   // [0, 100000]; 0 = the first bad frame stops the run (and open() needs every image file).
   int max_consecutive_bad_frames = 10;
@@ -68,6 +72,9 @@ struct ReplayRun {
   sunfusion::GateCounters gate;
   sunfusion::GateCounters vertical_gate;                     // the vertical cue's (if enabled)
   pipeline::SunAidedOdometry::VerticalStats vertical_stats;  // its calls, valid, errors
+  int world_up_answers = 0;        // cue answers that measured the world's up (if aligned)
+  double world_up_tilt_deg = 0.0;  // the estimate's angle from the assumed up, deg
+  Eigen::Vector3d world_up = Eigen::Vector3d::Zero();  // the world's up in use at the end
   int lost_frames = 0;
   double median_ms = 0.0;  // pipeline time per frame
   double p99_ms = 0.0;
