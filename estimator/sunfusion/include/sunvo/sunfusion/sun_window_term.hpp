@@ -226,7 +226,8 @@ struct SunFusionOptions {
 // world_up_alignment_frames for a world that is the first camera: 50 frames (5 s at 10 Hz, ten
 // answers at one every fifth frame) put the mean of answers with the cue's 0.3-1.7 deg spread
 // within 0.1-0.5 deg, while VO's tilt drifts by 0.01-0.5 deg in them (0.0002-0.01 deg/frame on
-// the simulated and real tracks, docs/experiment.md). Fixed from those figures, not tuned.
+// the simulated and real tracks, docs/experiment.md). Fixed from those figures before any run;
+// what it gives is measured in docs/vertical.md ("A world without gravity").
 inline constexpr int kWorldUpAlignmentFrames = 50;
 
 // The fusion's settings for an image sun estimator (Sun-CNN, Lalonde, Lalonde-VO), whose errors
