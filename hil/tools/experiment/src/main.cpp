@@ -262,6 +262,16 @@ int main(int argc, char** argv) {
       if (!run) return sunvo::cli::fail(kProgram, route->name + ": " + run.status().toString());
       std::fprintf(stderr, "  %-28s done (%.2f ms/frame median, %d lost)\n", run->name.c_str(),
                    run->median_ms, run->lost_frames);
+      if (with_vertical) {
+        const sunvo::sunfusion::GateCounters& g = run->vertical_gate;
+        std::fprintf(stderr,
+                     "    \"up\": %llu accepted, refused %llu by the gate, %llu by the innovation "
+                     "gate\n",
+                     static_cast<unsigned long long>(g.accepted),
+                     static_cast<unsigned long long>(g.rejected_cosine + g.rejected_vertical +
+                                                     g.rejected_invalid),
+                     static_cast<unsigned long long>(g.rejected_innovation));
+      }
       if (run->world_up_answers > 0) {
         std::fprintf(stderr, "    world's up from %d answers: %.3f deg from the true one\n",
                      run->world_up_answers, run->world_up_error_deg);
