@@ -28,6 +28,11 @@ TEST(RotationAngle, AccurateForTinyAngles) {
   EXPECT_NEAR(rotationAngle(C) / angle, 1.0, 1e-9);
 }
 
+TEST(AngleBetween, FullRangeAndZeroVector) {
+  EXPECT_NEAR(angleBetween(Eigen::Vector3d::UnitX(), -Eigen::Vector3d::UnitX()), M_PI, 1e-12);
+  EXPECT_EQ(angleBetween(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX()), 0.0);
+}
+
 TEST(Orthonormalize, ReturnsNearestRotation) {
   const Eigen::Matrix3d C =
       Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();

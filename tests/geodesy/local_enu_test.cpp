@@ -6,6 +6,7 @@
 #include <cmath>
 #include <random>
 
+#include "sunvo/core/geometry.hpp"
 #include "sunvo/kitti/calibration.hpp"
 #include "sunvo/kitti/oxts.hpp"
 
@@ -14,10 +15,6 @@ namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 const GeodeticPoint kKarlsruhe{49.015003823272, 8.4342971002335, 116.43032836914};
-
-double angleBetween(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  return std::atan2(a.cross(b).norm(), a.dot(b));
-}
 
 TEST(LocalEnu, OriginMapsToZero) {
   auto w = LocalEnuFrame::create(kKarlsruhe);

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <random>
 
+#include "sunvo/core/geometry.hpp"
+
 namespace sunvo::sunfusion {
 namespace {
 
@@ -26,7 +28,7 @@ Eigen::Vector3d noisy(const Eigen::Vector3d& up, double sigma, std::mt19937* rng
 }
 
 double angleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  return std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0)) / kDeg;
+  return angleBetween(a, b) / kDeg;
 }
 
 TEST(WorldUpAlignment, OffKeepsTheAssumedUp) {

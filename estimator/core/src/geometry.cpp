@@ -12,6 +12,12 @@ double rotationAngle(const Eigen::Matrix3d& C) {
   return std::atan2(s, c);
 }
 
+double angleBetween(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  const double n = a.norm() * b.norm();
+  if (n < 1e-12) return 0.0;
+  return std::atan2(a.cross(b).norm(), a.dot(b));
+}
+
 Eigen::Matrix3d orthonormalize(const Eigen::Matrix3d& M) {
   Eigen::JacobiSVD<Eigen::Matrix3d> svd(M, Eigen::ComputeFullU | Eigen::ComputeFullV);
   Eigen::Matrix3d D = Eigen::Matrix3d::Identity();

@@ -1,7 +1,8 @@
 #include "sunvo/sunfusion/world_up_alignment.hpp"
 
-#include <algorithm>
 #include <cmath>
+
+#include "sunvo/core/geometry.hpp"
 
 namespace sunvo::sunfusion {
 
@@ -40,8 +41,7 @@ void WorldUpAlignment::finish() {
       const auto k = static_cast<std::size_t>(i);
       double w = 1.0 / (sigma_[k] * sigma_[k]);
       if (iteration > 0) {
-        const double theta = std::acos(std::clamp(u_[k].dot(mean), -1.0, 1.0));
-        const double z = theta / (2.0 * sigma_[k]);
+        const double z = angleBetween(u_[k], mean) / (2.0 * sigma_[k]);
         w /= 1.0 + z * z;
       }
       sum += w * u_[k];
@@ -53,7 +53,7 @@ void WorldUpAlignment::finish() {
 }
 
 double WorldUpAlignment::tiltDeg() const {
-  return std::acos(std::clamp(up_.dot(assumed_), -1.0, 1.0)) * 180.0 / M_PI;
+  return angleBetween(up_, assumed_) * 180.0 / M_PI;
 }
 
 }  // namespace sunvo::sunfusion

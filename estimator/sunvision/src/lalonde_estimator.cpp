@@ -9,6 +9,8 @@
 #include <opencv2/imgproc.hpp>
 #include <string>
 
+#include "sunvo/core/geometry.hpp"
+
 namespace sunvo::sunvision {
 namespace {
 constexpr double kPi = std::numbers::pi;

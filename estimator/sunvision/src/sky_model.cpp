@@ -74,11 +74,4 @@ double wrapPi(double angle_rad) {
   return a - std::numbers::pi;
 }
 
-double angleBetween(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  const double n = a.norm() * b.norm();
-  if (n < 1e-12) return 0.0;
-  // atan2 of |a x b| and a.b: accurate for small and near-pi angles alike.
-  return std::atan2(a.cross(b).norm(), a.dot(b));
-}
-
 }  // namespace sunvo::sunvision

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "sunvo/core/geometry.hpp"
 #include "sunvo/dataset/dataset.hpp"
 #include "sunvo/dataset/kitti_rigs.hpp"
 #include "sunvo/pipeline/sun_aided_odometry.hpp"
@@ -92,8 +93,7 @@ Expected<RunResult> runRoute(const Route& route, const std::optional<SunSourceSp
   result.gate = odometry.sunCounters();
   result.vertical_gate = odometry.verticalCounters();
   result.world_up_answers = odometry.sunTerm().worldUpAlignment().used();
-  result.world_up_error_deg =
-      std::acos(std::clamp(odometry.worldUp().dot(true_up_w), -1.0, 1.0)) / kRad;
+  result.world_up_error_deg = angleBetween(odometry.worldUp(), true_up_w) / kRad;
   result.selfcal_pitch_mrad = odometry.lastSelfCalibration().pitch_mrad;
   result.selfcal_roll_mrad = odometry.lastSelfCalibration().roll_mrad;
   result.selfcal_resets = odometry.lastSelfCalibration().resets;

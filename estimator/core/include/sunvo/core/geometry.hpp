@@ -14,6 +14,11 @@ using Isometry3 = Eigen::Isometry3d;
 // where a bare arccos of the trace loses half the digits.
 double rotationAngle(const Eigen::Matrix3d& C);
 
+// Angle between two directions (need not be unit), rad, [0, pi]; 0 for a zero vector. atan2 of
+// |a x b| and a.b: accurate for small and near-pi angles alike (an arccos of the dot product
+// loses half the digits there).
+double angleBetween(const Eigen::Vector3d& a, const Eigen::Vector3d& b);
+
 // The nearest rotation matrix (in the Frobenius sense) to M, via SVD with det = +1.
 Eigen::Matrix3d orthonormalize(const Eigen::Matrix3d& M);
 

@@ -74,7 +74,4 @@ struct HorizonFrame {
 // Wraps an angle to (-pi, pi].
 double wrapPi(double angle_rad);
 
-// Angle between two directions (need not be unit), rad, [0, pi]; 0 for a zero vector.
-double angleBetween(const Eigen::Vector3d& a, const Eigen::Vector3d& b);
-
 }  // namespace sunvo::sunvision
