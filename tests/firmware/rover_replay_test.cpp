@@ -222,6 +222,29 @@ TEST(RoverReplay, VerticalCueInTheSunThread) {
   }
 }
 
+// The start levelled from the cue's first three answers (config/rover.yaml's setting,
+// docs/vertical.md "Levelling the rover's start"): the answers of frames 5, 10 and 15 go to the
+// levelling, not the filter, and the summary reports the tilt they measured (the replay starts
+// from the drive's OXTS pose, so it is small: 0.24 deg measured on the CI drive).
+TEST(RoverReplay, StartLevelledFromTheCue) {
+  int frames = 0;
+  const std::string drive = findOrRenderDrive(&frames);
+  ASSERT_FALSE(drive.empty()) << "no rendered drive";
+  const ProgramRun run = runProgram(drive, frames, "rover_level",
+                                    " --set sun.provider=none --set estimator.vertical.enabled=true"
+                                    " --set realtime.sun_wait_ms=60"
+                                    " --set estimator.fusion.world_up_alignment_frames=15"
+                                    " --set estimator.fusion.world_up_alignment_use=start_tilt");
+  EXPECT_EQ(run.rc, 0);
+  EXPECT_EQ(jsonNumber(run.json, "odometry_received"), frames);
+  std::smatch m;
+  const std::regex level(
+      "start tilt: ([0-9.]+) deg measured from ([0-9]+) cue answers and removed");
+  ASSERT_TRUE(std::regex_search(run.log, m, level)) << run.log;
+  EXPECT_LT(std::atof(m[1].str().c_str()), 0.5);
+  EXPECT_EQ(std::atoi(m[2].str().c_str()), 3);
+}
+
 // A copy of the rendered drive's gray images, OXTS and calibration (no colour pair) with injected
 // image faults: frame 3's left image missing, frame 4's right image truncated, frame 9's left
 // image of the wrong size and frame 14's right image with three channels.

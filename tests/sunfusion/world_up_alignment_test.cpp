@@ -92,5 +92,35 @@ TEST(WorldUpAlignment, AFullStoreFinishes) {
   EXPECT_NEAR(a.tiltDeg(), 1.0, 1e-6);
 }
 
+// For a world whose up is known (ENU) the estimate measures VO's tilt error at the start: the
+// correction turns it onto the assumed up, and its sigma is that of a mean (sigma / sqrt(n) for
+// n equal answers). finishIfPast ends the alignment only past the frames with three answers.
+TEST(WorldUpAlignment, TheTiltCorrectionTurnsTheEstimateOntoTheKnownUp) {
+  const Eigen::Vector3d up_w = Eigen::Vector3d::UnitZ();
+  // VO's world attitude is 5 deg off about x and -3 deg about y: it sees up at Exp(-e) up_w.
+  const Eigen::Vector3d e(5.0 * kDeg, -3.0 * kDeg, 0.0);
+  const Eigen::Vector3d seen = expSO3(-e) * up_w;
+  WorldUpAlignment a;
+  a.reset(15, up_w);
+  EXPECT_EQ(a.tiltCorrection(), Eigen::Vector3d::Zero());  // not done
+  for (std::uint64_t k = 5; k <= 10; k += 5) {
+    ASSERT_TRUE(a.takes(k));
+    a.add(seen, 0.5 * kDeg);
+  }
+  a.finishIfPast(20);  // two answers: not yet
+  EXPECT_FALSE(a.done());
+  ASSERT_TRUE(a.takes(15));
+  a.add(seen, 0.5 * kDeg);
+  a.finishIfPast(15);  // not past the frames
+  EXPECT_FALSE(a.done());
+  a.finishIfPast(16);
+  ASSERT_TRUE(a.done());
+  const Eigen::Vector3d c = a.tiltCorrection();
+  EXPECT_LT(angleBetween(expSO3(c) * a.up(), up_w), 1e-9);
+  EXPECT_NEAR(c.dot(up_w), 0.0, 1e-12);    // no heading in it
+  EXPECT_LT((c - e).norm(), 0.01 * kDeg);  // the tilt of e (it has no heading part here)
+  EXPECT_NEAR(a.sigma(), 0.5 * kDeg / std::sqrt(3.0), 1e-9);
+}
+
 }  // namespace
 }  // namespace sunvo::sunfusion

@@ -320,6 +320,11 @@ void BundleWindow::correctBaseAttitude(const Eigen::Matrix3d& C_b_bnew) {
   T_w_b_.linear() = orthonormalize(T_w_b_.linear() * C_b_bnew);
 }
 
+void BundleWindow::turnWorldAbout(const Eigen::Matrix3d& C_w_wnew, const Eigen::Vector3d& p_w) {
+  T_w_b_.translation() = p_w + C_w_wnew * (T_w_b_.translation() - p_w);
+  T_w_b_.linear() = orthonormalize(C_w_wnew * T_w_b_.linear());
+}
+
 Expected<WindowSolveSummary> BundleWindow::solve() {
   if (!initialized_) return failedPrecondition("BundleWindow::solve before init");
   if (size_ < 2) return failedPrecondition("window: solve needs at least 2 frames");

@@ -2,6 +2,8 @@
 
 #include <chrono>
 
+#include "sunvo/core/geometry.hpp"
+
 namespace sunvo::pipeline {
 
 Status SunAidedOptions::validate() const {
@@ -51,6 +53,7 @@ Status SunAidedOdometry::init(const SunAidedOptions& options, const StereoCamera
     window.setPostSolveHook(nullptr);
   }
   T_w_c_ = T_w_c0;
+  p_w_c0_ = T_w_c0.translation();
   sun_offered_ = 0;
   initialized_ = true;
   return Status::ok();
@@ -71,6 +74,7 @@ Expected<FrameResult> SunAidedOdometry::process(const StereoFrame& frame) {
   if (!initialized_ || input_ != OdometryInput::kImages) {
     return failedPrecondition("SunAidedOdometry::process(StereoFrame): not initialised for images");
   }
+  levelStartIfDue(frame.sequence);
   double vertical_ms = 0.0;
   if (vertical_active_ && isCueFrame(frame.sequence)) {
     const auto t0 = std::chrono::steady_clock::now();
@@ -110,6 +114,7 @@ Expected<vo::VoResult> SunAidedOdometry::process(const FrameFeatures& frame) {
     return failedPrecondition(
         "SunAidedOdometry::process(FrameFeatures): not initialised for features");
   }
+  levelStartIfDue(frame.sequence);
   const FrameFeatures* in = &frame;
   if (selfcal_.enabled()) {
     const auto t0 = std::chrono::steady_clock::now();
@@ -121,6 +126,16 @@ Expected<vo::VoResult> SunAidedOdometry::process(const FrameFeatures& frame) {
   Expected<vo::VoResult> r = tracks_.process(*in);
   if (r) T_w_c_ = r->T_w_c;
   return r;
+}
+
+void SunAidedOdometry::levelStartIfDue(std::uint64_t sequence) {
+  if (!options_.use_sun && !options_.vertical.enabled) return;  // no fusion, no cue
+  const std::optional<Eigen::Vector3d> e_w = sun_term_.takeStartLevelling(sequence);
+  if (!e_w) return;
+  const Eigen::Matrix3d C_w_wnew = expSO3(*e_w);
+  backEnd().turnWorldAbout(C_w_wnew, p_w_c0_);
+  T_w_c_.translation() = p_w_c0_ + C_w_wnew * (T_w_c_.translation() - p_w_c0_);
+  T_w_c_.linear() = C_w_wnew * T_w_c_.linear();
 }
 
 void SunAidedOdometry::setSolverTimeBudget(double seconds) {

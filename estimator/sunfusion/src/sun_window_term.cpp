@@ -136,6 +136,7 @@ Status SunWindowTerm::init(const SunFusionOptions& options) {
         chiSquareQuantile(1.0 - options.persistence_false_alarm, dof);
   }
   last_sequence_.reset();
+  levelled_ = false;
   num_used_ = 0;
   last_correction_ = Correction{};
   num_corrections_ = 0;
@@ -225,14 +226,14 @@ Status SunWindowTerm::onSolve(backend::BundleWindow& window) {
     // An undecided "up" of the first frames measures the world's up (world_up_alignment.hpp);
     // the first one past them ends that, and is used with the estimate.
     const bool aligning = channel == 1 && !p.decided && world_up_.takes(window.sequence(s));
-    const Eigen::Vector3d sun_w = channel == 0 ? p.obs.sun_w : world_up_.up();
+    const Eigen::Vector3d sun_w = channel == 0 ? p.obs.sun_w : worldUp();
     const Eigen::Vector3d sun_b = C_b_w * sun_w;
     bool cost_built = false;  // p.cost already holds this solve's residual
     const bool bias_cost = with_bias && channel == 0;
     if (!p.decided) {
       Eigen::Vector3d predicted_c = window.T_k_b(s).linear() * sun_b;
       if (bias_cost) predicted_c = turnAboutCameraY(predicted_c, bias_);
-      const double up = sun_w.dot(world_up_.up());
+      const double up = sun_w.dot(worldUp());
       GateResult r = gateSunMeasurement(channel == 0 ? options_.gate : options_.vertical_gate,
                                         predicted_c, up, p.obs.measurement);
       if (aligning && r == GateResult::kAccepted) {
@@ -372,6 +373,26 @@ void SunWindowTerm::onSolved(backend::BundleWindow& window) {
   }
 }
 
+std::optional<Eigen::Vector3d> SunWindowTerm::takeStartLevelling(std::uint64_t sequence) {
+  if (!levelsStart() || levelled_) return std::nullopt;
+  world_up_.finishIfPast(sequence);
+  if (!world_up_.done()) return std::nullopt;
+  levelled_ = true;
+  // The answers measured u_est = C_w_ck up_ck with VO's attitude; the truth is C_w_ck,true =
+  // Exp(e) C_w_ck with Exp(e) u_est = world_up, e normal to both (the heading is not seen).
+  const Eigen::Vector3d e = world_up_.tiltCorrection();
+  if (!e.allFinite() || !(world_up_.sigma() > 0.0)) return std::nullopt;
+  // The tilt part of P is now the estimate's; the heading part (and its bias covariance) stays.
+  const Eigen::Vector3d& u = options_.world_up;
+  const Eigen::Matrix3d uu = u * u.transpose();
+  const double s2 = world_up_.sigma() * world_up_.sigma();
+  P_ = uu * P_ * uu + s2 * (Eigen::Matrix3d::Identity() - uu);
+  P_tb_ = uu * P_tb_;
+  last_correction_ = {sequence, e, world_up_.used()};
+  ++num_corrections_;
+  return e;
+}
+
 bool SunWindowTerm::splitByGravity() const {
   return options_.split_drift_by_gravity &&
          options_.drift_adaptation == DriftAdaptation::kPersistence;
@@ -393,7 +414,7 @@ void SunWindowTerm::propagate(double frames) {
     return;
   }
   // Tilt (the plane normal to the world's up) and heading (about it) walk apart.
-  const Eigen::Vector3d& u = world_up_.up();
+  const Eigen::Vector3d& u = worldUp();
   const double qh = heading_drift_deg_per_frame_ * kDeg;
   const Eigen::Matrix3d uu = u * u.transpose();
   P_ += (q * q * (Eigen::Matrix3d::Identity() - uu) + qh * qh * uu) * frames;

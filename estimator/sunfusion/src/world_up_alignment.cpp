@@ -11,7 +11,12 @@ void WorldUpAlignment::reset(std::uint64_t frames, const Eigen::Vector3d& assume
   assumed_ = assumed_up;
   up_ = assumed_up;
   count_ = 0;
+  mean_sigma_ = 0.0;
   done_ = frames == 0;
+}
+
+void WorldUpAlignment::finishIfPast(std::uint64_t sequence) {
+  if (!done_ && sequence > frames_ && count_ >= kMinMeasurements) finish();
 }
 
 bool WorldUpAlignment::takes(std::uint64_t sequence) {
@@ -35,8 +40,10 @@ void WorldUpAlignment::finish() {
   if (count_ == 0) return;  // nothing measured: keep the assumed up
   // Weighted mean, then Cauchy reweighting about it (scale 2 sigma per answer).
   Eigen::Vector3d mean = assumed_;
+  double weight = 0.0;
   for (int iteration = 0; iteration < 6; ++iteration) {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    weight = 0.0;
     for (int i = 0; i < count_; ++i) {
       const auto k = static_cast<std::size_t>(i);
       double w = 1.0 / (sigma_[k] * sigma_[k]);
@@ -45,11 +52,20 @@ void WorldUpAlignment::finish() {
         w /= 1.0 + z * z;
       }
       sum += w * u_[k];
+      weight += w;
     }
     if (!(sum.norm() > 0.0) || !sum.allFinite()) return;  // keep the assumed up
     mean = sum.normalized();
   }
   up_ = mean;
+  mean_sigma_ = 1.0 / std::sqrt(weight);
+}
+
+Eigen::Vector3d WorldUpAlignment::tiltCorrection() const {
+  const Eigen::Vector3d axis = up_.cross(assumed_);
+  const double s = axis.norm();
+  if (!(s > 1e-12)) return Eigen::Vector3d::Zero();
+  return axis / s * angleBetween(up_, assumed_);
 }
 
 double WorldUpAlignment::tiltDeg() const {

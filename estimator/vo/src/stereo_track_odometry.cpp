@@ -86,6 +86,18 @@ Status StereoTrackOdometry::init(const VoOptions& options, const StereoCamera& c
   return Status::ok();
 }
 
+void StereoTrackOdometry::turnWorldAbout(const Eigen::Matrix3d& C_w_wnew,
+                                         const Eigen::Vector3d& p_w) {
+  const auto turn = [&](Isometry3& T_w_c) {
+    T_w_c.translation() = p_w + C_w_wnew * (T_w_c.translation() - p_w);
+    T_w_c.linear() = C_w_wnew * T_w_c.linear();
+  };
+  turn(T_w_last_);
+  turn(good_.T_w_c);
+  turn(lost_frame_.T_w_c);
+  window_.turnWorldAbout(C_w_wnew, p_w);
+}
+
 void StereoTrackOdometry::store(RefFrame& ref, const FrameFeatures& frame, const Isometry3& T_w_c) {
   ref.count = static_cast<int>(frame.observations.size());
   for (int i = 0; i < ref.count; ++i) {

@@ -190,6 +190,12 @@ void EstimatorStage::run() {
     const sunfusion::GateCounters& vgate = odometry_.verticalCounters();
     health.vertical_accepted.store(vgate.accepted, std::memory_order_relaxed);
     health.vertical_rejected.store(vgate.total() - vgate.accepted, std::memory_order_relaxed);
+    if (odometry_.sunTerm().startLevelled() && health.start_tilt_answers.load() == 0) {
+      const sunfusion::WorldUpAlignment& level = odometry_.sunTerm().worldUpAlignment();
+      health.start_tilt_mdeg.store(std::llround(1e3 * level.tiltDeg()), std::memory_order_relaxed);
+      health.start_tilt_answers.store(static_cast<std::uint64_t>(level.used()),
+                                      std::memory_order_relaxed);
+    }
 
     const PoseRecord pose = poseOf(*r, slot);
     ctx_.pool.release(ticket.slot);

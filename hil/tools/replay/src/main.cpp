@@ -93,6 +93,21 @@ int main(int argc, char** argv) {
                  "the cue's answers of the first N frames measure the world's up (-1: 50 when the "
                  "world is the first camera, which nobody levelled; 0 in ENU)")
       ->check(CLI::Range(-1, 100000));
+  bool level_start = false;
+  app.add_flag("--level-start", level_start,
+               "the cue's answers of the first frames (50 unless --world-up-alignment-frames) "
+               "measure the start attitude's tilt error, which is then removed (as a rover "
+               "without an INS does; ENU worlds only)");
+  app.add_option("--initial-sigma-deg", options.fusion.initial_attitude_sigma_deg,
+                 "the start attitude's std, deg (0.1: the first OXTS record's; the rover's 1)")
+      ->check(CLI::Range(0.001, 45.0));
+  app.add_option("--start-pitch-error-deg", options.start_pitch_error_deg,
+                 "start VO from the first camera pose pitched by this much (a rover's wrongly "
+                 "configured start tilt; evaluated against the true poses), deg")
+      ->check(CLI::Range(-30.0, 30.0));
+  app.add_option("--start-roll-error-deg", options.start_roll_error_deg,
+                 "the same about the optical axis, deg")
+      ->check(CLI::Range(-30.0, 30.0));
   bool self_calib = false;
   app.add_flag("--self-calib", self_calib,
                "online stereo self-calibration of the right camera (measures the right rows); its "
@@ -117,6 +132,9 @@ int main(int argc, char** argv) {
       "also write each run's poses, OUT/replay_poses_<run>.txt (KITTI) and _tum.txt (TUM)");
   if (auto code = sunvo::cli::parse(app, argc, argv)) return *code;
   options.fusion.estimate_base_attitude = !paper_form;
+  if (level_start) {
+    options.fusion.world_up_alignment_use = sunvo::sunfusion::WorldUpAlignmentUse::kStartTilt;
+  }
   if (self_calib) {
     options.pipeline.frontend.measure_v_right = true;
     options.pipeline.self_calibration.enabled = true;
@@ -240,7 +258,11 @@ int main(int argc, char** argv) {
                    static_cast<unsigned long long>(run->vertical_gate.accepted),
                    static_cast<unsigned long long>(run->vertical_stats.errors));
     }
-    if (run->world_up_answers > 0) {
+    if (run->start_levelled) {
+      std::fprintf(stderr,
+                   "  %-28s start tilt error %.3f deg measured from %d cue answers and removed\n",
+                   "", run->world_up_tilt_deg, run->world_up_answers);
+    } else if (run->world_up_answers > 0) {
       std::fprintf(stderr,
                    "  %-28s world's up (%.4f, %.4f, %.4f) from %d cue answers: %.3f deg off the "
                    "assumed one\n",

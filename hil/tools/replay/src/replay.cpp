@@ -1,5 +1,8 @@
 #include "sunvo/replay/replay.hpp"
 
+#include <cmath>
+
+#include "sunvo/core/geometry.hpp"
 #include "sunvo/kitti/stereo_source.hpp"
 #include "sunvo/metrics/metrics.hpp"
 
@@ -15,6 +18,10 @@ Status ReplayOptions::validate() const {
   SUNVO_RETURN_IF_ERROR(vertical.estimator.validate());
   if (world_up_alignment_frames < -1 || world_up_alignment_frames > 100000) {
     return invalidArgument("replay.world_up_alignment_frames out of range -1 or [0, 100000]");
+  }
+  if (!(std::abs(start_pitch_error_deg) <= 30.0) || !(std::abs(start_roll_error_deg) <= 30.0)) {
+    return invalidArgument(
+        "replay.start_pitch_error_deg / start_roll_error_deg out of range [-30, 30]");
   }
   if (max_consecutive_bad_frames < 0 || max_consecutive_bad_frames > 100000) {
     return invalidArgument("replay.max_consecutive_bad_frames out of range [0, 100000]");
@@ -86,10 +93,18 @@ Expected<ReplayRun> replayDrive(const dataset::Dataset& data, const ReplayOption
   sao.vertical = options.vertical;
   sao.fusion = image_sun != nullptr ? options.imageFusion() : options.fusion;
   sao.fusion.world_up = data.worldUp();
+  const bool level_start =
+      sao.fusion.world_up_alignment_use == sunfusion::WorldUpAlignmentUse::kStartTilt;
+  if (level_start && data.world() == dataset::WorldFrame::kFirstCamera) {
+    return invalidArgument(data.folder() +
+                           ": levelling the start needs a world whose up is known (ENU: a raw "
+                           "drive or a render), not the first camera");
+  }
   sao.fusion.world_up_alignment_frames =
-      options.world_up_alignment_frames >= 0              ? options.world_up_alignment_frames
-      : data.world() == dataset::WorldFrame::kFirstCamera ? sunfusion::kWorldUpAlignmentFrames
-                                                          : 0;
+      options.world_up_alignment_frames >= 0 ? options.world_up_alignment_frames
+      : level_start || data.world() == dataset::WorldFrame::kFirstCamera
+          ? sunfusion::kWorldUpAlignmentFrames
+          : 0;
   std::optional<sunfusion::SimulatedSunSource> sun_source;
   if (spec) {
     sao.fusion.gate = spec->gate;
@@ -98,8 +113,13 @@ Expected<ReplayRun> replayDrive(const dataset::Dataset& data, const ReplayOption
     SUNVO_RETURN_IF_ERROR(spec->model.validate());
     sun_source.emplace(spec->model);
   }
+  // The start pose, turned by the start attitude error (pitch about x, roll about z of camera 0).
+  Isometry3 T_w_c0 = data.T_w_c0();
+  T_w_c0.linear() = T_w_c0.linear() * expSO3(Eigen::Vector3d(options.start_pitch_error_deg, 0.0,
+                                                             options.start_roll_error_deg) *
+                                             (M_PI / 180.0));
   pipeline::SunAidedOdometry vo;
-  SUNVO_RETURN_IF_ERROR(vo.init(sao, data.camera(), data.T_w_c0()));
+  SUNVO_RETURN_IF_ERROR(vo.init(sao, data.camera(), T_w_c0));
 
   ReplayRun run;
   run.name = spec                   ? spec->name
@@ -170,6 +190,7 @@ Expected<ReplayRun> replayDrive(const dataset::Dataset& data, const ReplayOption
   run.world_up_answers = vo.sunTerm().worldUpAlignment().used();
   run.world_up_tilt_deg = vo.sunTerm().worldUpAlignment().tiltDeg();
   run.world_up = vo.worldUp();
+  run.start_levelled = vo.sunTerm().startLevelled();
   run.median_ms = metrics::percentile(ms, 0.5);
   run.p99_ms = metrics::percentile(ms, 0.99);
   return run;

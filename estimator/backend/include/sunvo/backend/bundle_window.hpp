@@ -213,6 +213,10 @@ class BundleWindow {
   // Rotates the base's world attitude about the base's own origin: C_w_b <- C_w_b * C_b_bnew.
   // Every world pose the window derives afterwards (newest pose, the next base) follows.
   void correctBaseAttitude(const Eigen::Matrix3d& C_b_bnew);
+  // Turns the base's world pose about the world point p_w: C_w_b <- C_w_w' C_w_b,
+  // p_w_b <- p_w + C_w_w' (p_w_b - p_w): a correction of everything VO built since it was at p_w
+  // (e.g. a start attitude that was wrong).
+  void turnWorldAbout(const Eigen::Matrix3d& C_w_wnew, const Eigen::Vector3d& p_w);
 
   const WindowOptions& options() const { return options_; }
 

@@ -154,6 +154,9 @@ class SunAidedOdometry {
   vo::StereoTrackOdometry& backEnd() {
     return input_ == OdometryInput::kImages ? vo_.odometry() : tracks_;
   }
+  // fusion.world_up_alignment_use kStartTilt: before frame `sequence`, turns VO's world about
+  // the first camera once the fusion has measured the start's tilt error.
+  void levelStartIfDue(std::uint64_t sequence);
 
   SunAidedOptions options_;
   OdometryInput input_ = OdometryInput::kImages;
@@ -168,6 +171,7 @@ class SunAidedOdometry {
   bool vertical_active_ = false;
   VerticalStats vertical_stats_;
   Isometry3 T_w_c_ = Isometry3::Identity();
+  Eigen::Vector3d p_w_c0_ = Eigen::Vector3d::Zero();  // the first camera's world position
   std::uint64_t sun_offered_ = 0;
   bool initialized_ = false;
 };

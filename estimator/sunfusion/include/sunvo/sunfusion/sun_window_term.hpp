@@ -85,7 +85,9 @@
 // (verticalCounters()). One sun direction leaves the rotation about the sun axis free; "up"
 // fixes roll and pitch, so the two together observe the whole attitude. Where the world's up is
 // not known (a world that is the first camera), world_up_alignment_frames > 0 measures it from
-// the channel's first answers before any is fused (world_up_alignment.hpp).
+// the channel's first answers before any is fused (world_up_alignment.hpp); where it is known but
+// the start attitude's tilt is not (a rover), the same answers measure that tilt error, which the
+// caller removes by turning VO's world (world_up_alignment_use kStartTilt, takeStartLevelling).
 //
 // Nothing here allocates per frame: init() builds every cost function a slot of the window can
 // need (3-D and azimuth-only sun, in the form the options ask for, and the priors), and a
@@ -121,6 +123,20 @@ inline std::span<const std::string_view> enumNames(DriftAdaptation) {
   return kNames;
 }
 
+// What the vertical channel's answers of the first world_up_alignment_frames frames measure.
+//  kWorldUp: the world's up, which nobody measured (a world that is the first camera): their
+//    estimate becomes the world's up of the vertical channel, its gate and the walk's split.
+//  kStartTilt: VO's tilt error at the start, where the world's up is known (ENU) but the start
+//    attitude's roll and pitch are not (a rover parked on a slope and started with the configured
+//    ones): VO's attitude is turned by the rotation that takes the estimate onto world_up (roll
+//    and pitch only), together with the positions built since the first frame, and the tilt part
+//    of the attitude covariance becomes the estimate's. world_up stays the world's up.
+enum class WorldUpAlignmentUse { kWorldUp, kStartTilt };
+inline std::span<const std::string_view> enumNames(WorldUpAlignmentUse) {
+  static constexpr std::string_view kNames[] = {"world_up", "start_tilt"};
+  return kNames;
+}
+
 struct SunFusionOptions {
   SunGateOptions gate;
   // Gate of the vertical channel (addVertical): the default refuses an "up" more than 10 deg from
@@ -140,6 +156,8 @@ struct SunFusionOptions {
   // a world that is the first camera (KITTI odometry, track folders), whose tilt nobody measured:
   // kWorldUpAlignmentFrames.
   int world_up_alignment_frames = 0;
+  // What those answers measure (above): the world's up, or VO's tilt error at the start.
+  WorldUpAlignmentUse world_up_alignment_use = WorldUpAlignmentUse::kWorldUp;
   // Robust loss on the whitened sun residual: Cauchy scale in sigmas, (0, 100]; 0 = no loss.
   double loss_scale = 0.0;
   // Estimate a correction of the base's world attitude (see above); false = the paper's form.
@@ -199,6 +217,7 @@ struct SunFusionOptions {
     v("gate", s.gate);
     v("vertical_gate", s.vertical_gate);
     v("world_up_alignment_frames", s.world_up_alignment_frames);
+    v("world_up_alignment_use", s.world_up_alignment_use);
     v("loss_scale", s.loss_scale);
     v("estimate_base_attitude", s.estimate_base_attitude);
     v("initial_attitude_sigma_deg", s.initial_attitude_sigma_deg);
@@ -261,8 +280,18 @@ class SunWindowTerm {
   // k, sigma its 1-sigma angle (rad). observation.sun_w is not read: the world's up is worldUp().
   void addVertical(const SunObservation& observation);
   // The world's up the vertical channel uses: options.world_up, or once aligned
-  // (world_up_alignment_frames > 0) its estimate; and the alignment's state.
-  const Eigen::Vector3d& worldUp() const { return world_up_.up(); }
+  // (world_up_alignment_frames > 0, kWorldUp) its estimate; and the alignment's state (with
+  // kStartTilt its estimate measured the start's tilt error: tiltDeg()).
+  // kStartTilt, called before frame `sequence` is processed: once the alignment is done (the
+  // frame is past its frames and enough answers were taken), the world-frame rotation vector e
+  // (rad) by which the caller must turn VO's world poses, C_w_c <- Exp(e) C_w_c, and the
+  // positions built since the first frame about it (the error was there from the start); the tilt
+  // part of the attitude covariance becomes the estimate's. Given once; nullopt otherwise.
+  std::optional<Eigen::Vector3d> takeStartLevelling(std::uint64_t sequence);
+  bool startLevelled() const { return levelled_; }
+  const Eigen::Vector3d& worldUp() const {
+    return levelsStart() ? options_.world_up : world_up_.up();
+  }
   const WorldUpAlignment& worldUpAlignment() const { return world_up_; }
 
   const GateCounters& counters() const { return counters_; }
@@ -330,6 +359,10 @@ class SunWindowTerm {
                          const double* delta_b, double db, Eigen::Vector3d* r,
                          Eigen::Matrix<double, 3, 3, Eigen::RowMajor>* J_d, Eigen::Vector3d* J_bias,
                          int* m);
+  bool levelsStart() const {
+    return options_.world_up_alignment_use == WorldUpAlignmentUse::kStartTilt &&
+           options_.world_up_alignment_frames > 0;
+  }
   bool biasEnabled() const {
     return options_.sun_bias_sigma_deg > 0.0 && options_.estimate_base_attitude;
   }
@@ -397,6 +430,7 @@ class SunWindowTerm {
   double persistence_T_ = 0.0;
   std::array<double, 4> persistence_bound_{};  // chi-square quantile by rank 1..3
   std::optional<std::uint64_t> last_sequence_;
+  bool levelled_ = false;  // kStartTilt: the start was levelled (takeStartLevelling)
   AttitudePriorResidual* prior_ = nullptr;  // owned by prior_cost_
   std::unique_ptr<ceres::CostFunction> prior_cost_;
   AttitudeBiasPriorResidual* bias_prior_ = nullptr;  // owned by bias_prior_cost_

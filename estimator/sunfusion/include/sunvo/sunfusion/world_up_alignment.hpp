@@ -18,6 +18,11 @@
 // estimate (measured, docs/vertical.md: 0.04-0.11 deg off on two rendered drives; 1.1-2.0 deg on
 // the real 0020 tracks, whose VO is 0.9 deg off in tilt by frame 10 and 1.6 deg by frame 50).
 //
+// The same answers serve a world whose up is known (ENU) but whose start attitude is not level
+// as configured (a rover parked on a slope): there their mean measures VO's tilt error at the
+// start, tiltCorrection() is the rotation that removes it, and the fusion turns VO's world by it
+// (SunFusionOptions::world_up_alignment_use kStartTilt).
+//
 // No allocation: at most kMaxMeasurements answers are kept.
 
 #include <Eigen/Core>
@@ -48,6 +53,14 @@ class WorldUpAlignment {
   int used() const { return count_; }
   // Angle between the estimate and the assumed up, deg (0 before it is done).
   double tiltDeg() const;
+  // The rotation vector e (rad, world frame) with Exp(e) up() = the assumed up: for a world whose
+  // up is known, VO's tilt error while the answers were taken. Zero before it is done.
+  Eigen::Vector3d tiltCorrection() const;
+  // 1-sigma angle of the estimate, rad: 1 / sqrt(sum of the final weights) (0 before it is done).
+  double sigma() const { return mean_sigma_; }
+  // Finishes now when the frames are past and enough answers were taken (takes() does it on the
+  // first answer past the frames).
+  void finishIfPast(std::uint64_t sequence);
 
  private:
   void finish();
@@ -59,6 +72,7 @@ class WorldUpAlignment {
   std::array<Eigen::Vector3d, kMaxMeasurements> u_{};
   std::array<double, kMaxMeasurements> sigma_{};
   int count_ = 0;
+  double mean_sigma_ = 0.0;
 };
 
 }  // namespace sunvo::sunfusion

@@ -80,6 +80,10 @@ class StereoTrackOdometry {
   Expected<VoResult> process(const FrameFeatures& frame);
 
   backend::BundleWindow& window() { return window_; }  // e.g. to set the pose-residual hook
+  // Turns every world pose kept here about the world point p_w (C_w_c <- C_w_w' C_w_c,
+  // p_w_c <- p_w + C_w_w' (p_w_c - p_w)): a correction of the whole trajectory so far, e.g. a
+  // start attitude found to be wrong. The next frame's motion is measured as before.
+  void turnWorldAbout(const Eigen::Matrix3d& C_w_wnew, const Eigen::Vector3d& p_w);
   const VoOptions& options() const { return options_; }
 
  private:

@@ -50,8 +50,16 @@ struct ReplayOptions {
   double image_sun_bias_length_frames = sunfusion::ImageEstimatorFusion::kSunBiasLengthFrames;
   // fusion.world_up_alignment_frames for the drive, frames, -1 or [0, 100000]: -1 = by its world,
   // sunfusion::kWorldUpAlignmentFrames when that is the first camera (KITTI odometry: no gravity
-  // in it), 0 in ENU (raw drives and renders: the first pose comes from the INS).
+  // in it) or when fusion.world_up_alignment_use is kStartTilt (an ENU world whose start tilt is
+  // measured, as on a rover; not for a first-camera world), 0 in ENU (raw drives and renders: the
+  // first pose comes from the INS).
   int world_up_alignment_frames = -1;
+  // A start attitude that is wrong in tilt, deg, [-30, 30] each: VO starts from the first camera
+  // pose turned by this much about the camera's x axis (pitch) and optical axis (roll), as on a
+  // rover whose configured start pitch and roll (world.camera_pitch_deg / camera_roll_deg) are not
+  // those of the ground it was parked on. The evaluation stays against the true poses.
+  double start_pitch_error_deg = 0.0;
+  double start_roll_error_deg = 0.0;
   // Bad frames in a row that are dropped before the run stops with the last one's error, frames,
   // [0, 100000]; 0 = the first bad frame stops the run (and open() needs every image file).
   int max_consecutive_bad_frames = 10;
@@ -75,6 +83,7 @@ struct ReplayRun {
   int world_up_answers = 0;        // cue answers that measured the world's up (if aligned)
   double world_up_tilt_deg = 0.0;  // the estimate's angle from the assumed up, deg
   Eigen::Vector3d world_up = Eigen::Vector3d::Zero();  // the world's up in use at the end
+  bool start_levelled = false;  // the answers measured the start's tilt error, which was removed
   int lost_frames = 0;
   double median_ms = 0.0;  // pipeline time per frame
   double p99_ms = 0.0;
