@@ -224,8 +224,8 @@ TEST(RoverReplay, VerticalCueInTheSunThread) {
 
 // The start levelled from the cue's first three answers (config/rover.yaml's setting,
 // docs/vertical.md "Levelling the rover's start"): the answers of frames 5, 10 and 15 go to the
-// levelling, not the filter, and the summary reports the tilt they measured (the replay starts
-// from the drive's OXTS pose, so it is small: 0.24 deg measured on the CI drive).
+// levelling, not the filter, and the summary and the journal report the tilt they measured (the
+// replay starts from the drive's OXTS pose, so it is small: 0.24 deg measured on the CI drive).
 TEST(RoverReplay, StartLevelledFromTheCue) {
   int frames = 0;
   const std::string drive = findOrRenderDrive(&frames);
@@ -243,6 +243,10 @@ TEST(RoverReplay, StartLevelledFromTheCue) {
   ASSERT_TRUE(std::regex_search(run.log, m, level)) << run.log;
   EXPECT_LT(std::atof(m[1].str().c_str()), 0.5);
   EXPECT_EQ(std::atoi(m[2].str().c_str()), 3);
+  // The journal's event line (info priority), once.
+  const std::regex event(
+      "<6>sunvo_rover: start tilt: [0-9.]+ deg measured from 3 vertical-cue answers");
+  EXPECT_TRUE(std::regex_search(run.log, m, event)) << run.log;
 }
 
 // A copy of the rendered drive's gray images, OXTS and calibration (no colour pair) with injected

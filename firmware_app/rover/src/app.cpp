@@ -345,6 +345,8 @@ HealthSample RoverApp::healthSample(TimeNs now) const {
   out.poses_published = g(h.poses_published);
   out.source_ended = s.channels.capture_done.load(std::memory_order_acquire);
   out.estimator_done = s.channels.estimator_done.load(std::memory_order_acquire);
+  out.start_tilt_answers = g(h.start_tilt_answers);
+  out.start_tilt_mdeg = h.start_tilt_mdeg.load(std::memory_order_relaxed);
   return out;
 }
 

@@ -20,7 +20,15 @@ void Supervisor::ready() {
 
 std::optional<int> Supervisor::tick(TimeNs now) {
   const std::uint64_t jumps_before = watch_.clockJumps();
-  const HealthFault fault = watch_.update(app_.healthSample(now));
+  const HealthSample sample = app_.healthSample(now);
+  const HealthFault fault = watch_.update(sample);
+  if (!start_tilt_logged_ && sample.start_tilt_answers > 0) {
+    log_.log(runtime::LogPriority::kInfo,
+             "start tilt: %.3f deg measured from %llu vertical-cue answers and removed",
+             static_cast<double>(sample.start_tilt_mdeg) * 1e-3,
+             static_cast<unsigned long long>(sample.start_tilt_answers));
+    start_tilt_logged_ = true;
+  }
   if (watch_.clockJumps() != jumps_before) {
     log_.log(runtime::LogPriority::kWarning,
              "clock: the wall clock jumped %+.3f s (UTC - monotonic; jump %llu); frame times keep "

@@ -25,6 +25,10 @@ Status ExperimentOptions::validate() const {
     return invalidArgument(
         "experiment.true_up_pitch_deg / true_up_roll_deg out of range [-30, 30]");
   }
+  if (!(std::abs(start_pitch_error_deg) <= 30.0 && std::abs(start_roll_error_deg) <= 30.0)) {
+    return invalidArgument(
+        "experiment.start_pitch_error_deg / start_roll_error_deg out of range [-30, 30]");
+  }
   return Status::ok();
 }
 
@@ -60,9 +64,13 @@ Expected<RunResult> runRoute(const Route& route, const std::optional<SunSourceSp
     sao.vertical.enabled = true;
     vertical.emplace(*options.vertical);
   }
+  Isometry3 T_w_c0 = route.T_w_c_gt[0];
+  T_w_c0.linear() = T_w_c0.linear() * expSO3(Eigen::Vector3d(options.start_pitch_error_deg, 0.0,
+                                                             options.start_roll_error_deg) *
+                                             kRad);
   pipeline::SunAidedOdometry odometry;
   SUNVO_RETURN_IF_ERROR(
-      odometry.init(sao, route.camera, route.T_w_c_gt[0], pipeline::OdometryInput::kFeatures));
+      odometry.init(sao, route.camera, T_w_c0, pipeline::OdometryInput::kFeatures));
 
   RunResult result;
   result.name = spec ? spec->name : "Pure VO";
@@ -94,6 +102,9 @@ Expected<RunResult> runRoute(const Route& route, const std::optional<SunSourceSp
   result.vertical_gate = odometry.verticalCounters();
   result.world_up_answers = odometry.sunTerm().worldUpAlignment().used();
   result.world_up_error_deg = angleBetween(odometry.worldUp(), true_up_w) / kRad;
+  result.start_levelled = odometry.sunTerm().startLevelled();
+  if (result.start_levelled)
+    result.start_tilt_deg = odometry.sunTerm().worldUpAlignment().tiltDeg();
   result.selfcal_pitch_mrad = odometry.lastSelfCalibration().pitch_mrad;
   result.selfcal_roll_mrad = odometry.lastSelfCalibration().roll_mrad;
   result.selfcal_resets = odometry.lastSelfCalibration().resets;

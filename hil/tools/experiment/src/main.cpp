@@ -122,6 +122,18 @@ int main(int argc, char** argv) {
                  "the \"up\" answers of the first N frames measure the world's up (default 0: "
                  "the first camera's -y is up; 50: sunvo_replay's for a first-camera world)")
       ->check(CLI::Range(0, 100000));
+  app.add_option("--start-pitch-error-deg", options.start_pitch_error_deg,
+                 "start VO from the first true pose pitched by this much (a rover's wrongly "
+                 "configured start tilt; evaluated against the true poses), deg")
+      ->check(CLI::Range(-30.0, 30.0));
+  app.add_option("--start-roll-error-deg", options.start_roll_error_deg,
+                 "the same about the optical axis, deg")
+      ->check(CLI::Range(-30.0, 30.0));
+  bool level_start = false;
+  app.add_flag("--level-start", level_start,
+               "the \"up\" answers of the first frames (15 unless --world-up-alignment-frames) "
+               "measure the start attitude's tilt error, which is then removed (the rover's "
+               "setting)");
   app.add_flag("--self-calib", self_calib,
                "online stereo self-calibration of the right camera before the odometry");
   sunvo::cli::addSelfCalibrationRateOptions(app, options.self_calibration);
@@ -194,6 +206,12 @@ int main(int argc, char** argv) {
     return sunvo::cli::kExitUsage;
   }
   if (initial_sigma_deg) options.fusion.initial_attitude_sigma_deg = *initial_sigma_deg;
+  if (level_start) {
+    options.fusion.world_up_alignment_use = sunvo::sunfusion::WorldUpAlignmentUse::kStartTilt;
+    if (options.fusion.world_up_alignment_frames == 0) {
+      options.fusion.world_up_alignment_frames = sunvo::sunfusion::kStartTiltFrames;
+    }
+  }
   if (max_drift_deg) options.fusion.max_drift_deg_per_frame = *max_drift_deg;
   if (drift_rule == "persistence") {
     options.fusion.drift_adaptation = sunvo::sunfusion::DriftAdaptation::kPersistence;
@@ -272,7 +290,10 @@ int main(int argc, char** argv) {
                                                      g.rejected_invalid),
                      static_cast<unsigned long long>(g.rejected_innovation));
       }
-      if (run->world_up_answers > 0) {
+      if (run->start_levelled) {
+        std::fprintf(stderr, "    start tilt error %.3f deg measured from %d answers and removed\n",
+                     run->start_tilt_deg, run->world_up_answers);
+      } else if (run->world_up_answers > 0) {
         std::fprintf(stderr, "    world's up from %d answers: %.3f deg from the true one\n",
                      run->world_up_answers, run->world_up_error_deg);
       }

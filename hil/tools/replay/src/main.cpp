@@ -95,7 +95,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(-1, 100000));
   bool level_start = false;
   app.add_flag("--level-start", level_start,
-               "the cue's answers of the first frames (50 unless --world-up-alignment-frames) "
+               "the cue's answers of the first frames (15 unless --world-up-alignment-frames) "
                "measure the start attitude's tilt error, which is then removed (as a rover "
                "without an INS does; ENU worlds only)");
   app.add_option("--initial-sigma-deg", options.fusion.initial_attitude_sigma_deg,

@@ -101,10 +101,10 @@ Expected<ReplayRun> replayDrive(const dataset::Dataset& data, const ReplayOption
                            "drive or a render), not the first camera");
   }
   sao.fusion.world_up_alignment_frames =
-      options.world_up_alignment_frames >= 0 ? options.world_up_alignment_frames
-      : level_start || data.world() == dataset::WorldFrame::kFirstCamera
-          ? sunfusion::kWorldUpAlignmentFrames
-          : 0;
+      options.world_up_alignment_frames >= 0              ? options.world_up_alignment_frames
+      : level_start                                       ? sunfusion::kStartTiltFrames
+      : data.world() == dataset::WorldFrame::kFirstCamera ? sunfusion::kWorldUpAlignmentFrames
+                                                          : 0;
   std::optional<sunfusion::SimulatedSunSource> sun_source;
   if (spec) {
     sao.fusion.gate = spec->gate;

@@ -249,6 +249,12 @@ struct SunFusionOptions {
 // what it gives is measured in docs/vertical.md ("A world without gravity").
 inline constexpr int kWorldUpAlignmentFrames = 50;
 
+// world_up_alignment_frames for kStartTilt (a rover's start): the fewest frames that give the
+// alignment its three answers at one every fifth frame. The levelling only has to bring the
+// start's tilt error inside the gates; the filter refines it with every later answer. Chosen
+// against 50 on validation drives (docs/vertical.md, "Levelling the rover's start").
+inline constexpr int kStartTiltFrames = 15;
+
 // The fusion's settings for an image sun estimator (Sun-CNN, Lalonde, Lalonde-VO), whose errors
 // stay alike for a street and can be biased for a whole drive; sunvo_replay's image-estimator
 // options and the rover's estimator defaults start from these.
@@ -282,6 +288,10 @@ class SunWindowTerm {
   // The world's up the vertical channel uses: options.world_up, or once aligned
   // (world_up_alignment_frames > 0, kWorldUp) its estimate; and the alignment's state (with
   // kStartTilt its estimate measured the start's tilt error: tiltDeg()).
+  const Eigen::Vector3d& worldUp() const {
+    return levelsStart() ? options_.world_up : world_up_.up();
+  }
+  const WorldUpAlignment& worldUpAlignment() const { return world_up_; }
   // kStartTilt, called before frame `sequence` is processed: once the alignment is done (the
   // frame is past its frames and enough answers were taken), the world-frame rotation vector e
   // (rad) by which the caller must turn VO's world poses, C_w_c <- Exp(e) C_w_c, and the
@@ -289,10 +299,6 @@ class SunWindowTerm {
   // part of the attitude covariance becomes the estimate's. Given once; nullopt otherwise.
   std::optional<Eigen::Vector3d> takeStartLevelling(std::uint64_t sequence);
   bool startLevelled() const { return levelled_; }
-  const Eigen::Vector3d& worldUp() const {
-    return levelsStart() ? options_.world_up : world_up_.up();
-  }
-  const WorldUpAlignment& worldUpAlignment() const { return world_up_; }
 
   const GateCounters& counters() const { return counters_; }
   const GateCounters& verticalCounters() const { return vertical_counters_; }

@@ -28,8 +28,9 @@ class Supervisor {
   // READY=1 and the "ready" line (the threads run).
   void ready();
   // One look at the counters at `now` (monotonic). Logs a fault when it appears (warning) and
-  // when it clears (info); pings the watchdog when due and healthy. Returns kFaultExitCode after
-  // logging the reason (error) when the present fault lasted past health.fault_exit_s.
+  // when it clears (info), and the start's levelling once (info); pings the watchdog when due and
+  // healthy. Returns kFaultExitCode after logging the reason (error) when the present fault lasted
+  // past health.fault_exit_s.
   std::optional<int> tick(TimeNs now);
   // STOPPING=1 and the "stopping" line.
   void stopping(const char* why);
@@ -45,6 +46,7 @@ class Supervisor {
   TimeNs ping_period_ns_;  // half of $WATCHDOG_USEC; 0: no watchdog
   TimeNs next_ping_ns_;
   HealthFault logged_ = HealthFault::kNone;
+  bool start_tilt_logged_ = false;  // the start's levelling was logged (info)
   std::uint64_t pings_ = 0;
 };
 

@@ -61,6 +61,12 @@ struct ExperimentOptions {
   // 0, 0 = level.
   double true_up_pitch_deg = 0.0;
   double true_up_roll_deg = 0.0;
+  // A start attitude that is wrong in tilt, deg, [-30, 30] each: VO starts from the first true
+  // pose turned by this much about the camera's x axis (pitch) and optical axis (roll), as a
+  // rover started with the wrong configured pitch and roll (fusion.world_up_alignment_use
+  // kStartTilt levels it from the simulated "up"). The evaluation stays against the true poses.
+  double start_pitch_error_deg = 0.0;
+  double start_roll_error_deg = 0.0;
   // Online stereo self-calibration of the tracks before the odometry (off by default).
   selfcal::StereoSelfCalibrationOptions self_calibration;
   // Gate and world_up are set per source / route. VO starts at the ground-truth first pose, so the
@@ -81,6 +87,8 @@ struct RunResult {
   metrics::TiltMetrics tilt;              // attitude error split into tilt and heading
   int world_up_answers = 0;               // "up" answers that measured the world's up (if aligned)
   double world_up_error_deg = 0.0;  // angle of the world's up in use from the route's true one
+  bool start_levelled = false;      // kStartTilt: the start's tilt error was measured and removed
+  double start_tilt_deg = 0.0;      // the tilt error the "up" answers measured, deg
   int lost_frames = 0;
   double median_ms = 0.0;  // VO time per frame (association, RANSAC, window), median
   double p99_ms = 0.0;

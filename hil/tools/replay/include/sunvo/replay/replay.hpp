@@ -50,9 +50,9 @@ struct ReplayOptions {
   double image_sun_bias_length_frames = sunfusion::ImageEstimatorFusion::kSunBiasLengthFrames;
   // fusion.world_up_alignment_frames for the drive, frames, -1 or [0, 100000]: -1 = by its world,
   // sunfusion::kWorldUpAlignmentFrames when that is the first camera (KITTI odometry: no gravity
-  // in it) or when fusion.world_up_alignment_use is kStartTilt (an ENU world whose start tilt is
-  // measured, as on a rover; not for a first-camera world), 0 in ENU (raw drives and renders: the
-  // first pose comes from the INS).
+  // in it), sunfusion::kStartTiltFrames when fusion.world_up_alignment_use is kStartTilt (an ENU
+  // world whose start tilt is measured, as on a rover; not for a first-camera world), 0 in ENU
+  // (raw drives and renders: the first pose comes from the INS).
   int world_up_alignment_frames = -1;
   // A start attitude that is wrong in tilt, deg, [-30, 30] each: VO starts from the first camera
   // pose turned by this much about the camera's x axis (pitch) and optical axis (roll), as on a
