@@ -120,6 +120,16 @@ TEST(Experiment, TheBiasStateDoesNotFollowASourceBiasedForTheWholeDrive) {
   EXPECT_GT(r.kept.gate.accepted, 100u);
 }
 
+// The simulated "up" of the vertical tests: 1 deg per axis, 10 % outliers of 8 deg, half the
+// frames without an answer.
+sunfusion::VerticalErrorModel verticalLikeUp() {
+  sunfusion::VerticalErrorModel up;
+  up.outlier_share = 0.1;
+  up.dropout_share = 0.5;
+  up.seed = 11;
+  return up;
+}
+
 // A first camera that was not level (1.2 deg pitch, -1.4 deg roll, the vertical cue's reading on
 // the 11 real KITTI 00 frames): route 06 with `sunvo_experiment --seed 1 --vertical
 // --true-up-pitch-deg 1.2 --true-up-roll-deg -1.4 [--world-up-alignment-frames 0]`. Told that
@@ -135,11 +145,7 @@ TEST(Experiment, AnUnlevelledFirstCameraIsAlignedNotFollowed) {
   opt.vo.window.max_solver_time_in_seconds = 60.0;
   auto pure = runRoute(*route, std::nullopt, opt);
   ASSERT_TRUE(pure) << pure.status().toString();
-  sunfusion::VerticalErrorModel up;
-  up.outlier_share = 0.1;
-  up.dropout_share = 0.5;
-  up.seed = 11;
-  opt.vertical = up;
+  opt.vertical = verticalLikeUp();
   opt.true_up_pitch_deg = 1.2;
   opt.true_up_roll_deg = -1.4;
   auto told = runRoute(*route, std::nullopt, opt);
@@ -173,11 +179,7 @@ TEST(Experiment, AWrongStartTiltIsLevelledFromTheUp) {
   opt.max_frames = 300;
   opt.fusion.initial_attitude_sigma_deg = 1.0;
   opt.start_pitch_error_deg = 8.0;
-  sunfusion::VerticalErrorModel up;
-  up.outlier_share = 0.1;
-  up.dropout_share = 0.5;
-  up.seed = 11;
-  opt.vertical = up;
+  opt.vertical = verticalLikeUp();
   auto stuck = runRoute(*route, std::nullopt, opt);
   ASSERT_TRUE(stuck) << stuck.status().toString();
   EXPECT_FALSE(stuck->start_levelled);
