@@ -48,6 +48,17 @@ TEST(RoverConfig, TheShippedConfigsLoad) {
   // The vertical cue, in the sun thread, with time to answer (docs/vertical.md).
   EXPECT_TRUE(rover->estimator.vertical.enabled);
   EXPECT_GE(rover->realtime.sun_wait_ms, 20.0);
+  // Its first three answers level the start (docs/vertical.md, "Levelling the rover's start"); the
+  // replay file starts from the drive's OXTS pose and does not.
+  EXPECT_EQ(rover->estimator.fusion.world_up_alignment_use,
+            sunfusion::WorldUpAlignmentUse::kStartTilt);
+  EXPECT_EQ(rover->estimator.fusion.world_up_alignment_frames, sunfusion::kStartTiltFrames);
+  EXPECT_EQ(replay->estimator.fusion.world_up_alignment_frames, 0);
+  auto bad_use = loadRoverConfig(std::string(SUNVO_SOURCE_DIR) + "/config/rover.yaml",
+                                 {{"estimator.fusion.world_up_alignment_use", "level"}});
+  ASSERT_FALSE(bad_use);
+  EXPECT_NE(bad_use.status().message().find("world_up_alignment_use"), std::string::npos)
+      << bad_use.status().message();
   auto gray = loadRoverConfig(std::string(SUNVO_SOURCE_DIR) + "/config/rover.yaml",
                               {{"sun.provider", "sun_cnn"}});
   EXPECT_TRUE(gray) << gray.status().toString();
