@@ -374,7 +374,7 @@ void SunWindowTerm::onSolved(backend::BundleWindow& window) {
 }
 
 std::optional<Eigen::Vector3d> SunWindowTerm::takeStartLevelling(std::uint64_t sequence) {
-  if (!levelsStart() || levelled_) return std::nullopt;
+  if (!options_.levelsStartTilt() || levelled_) return std::nullopt;
   world_up_.finishIfPast(sequence);
   if (!world_up_.done()) return std::nullopt;
   levelled_ = true;

@@ -423,9 +423,7 @@ std::string RoverApp::summary() const {
             g(h.vertical_calls), g(h.vertical_valid), g(h.vertical_errors), g(h.vertical_accepted),
             g(h.vertical_rejected));
   }
-  if (s.config.estimator.fusion.world_up_alignment_use ==
-          sunfusion::WorldUpAlignmentUse::kStartTilt &&
-      s.config.estimator.fusion.world_up_alignment_frames > 0) {
+  if (s.config.estimator.fusion.levelsStartTilt()) {
     if (h.start_tilt_answers.load() > 0) {
       appendf(&o, "  start tilt: %.3f deg measured from %" PRIu64 " cue answers and removed\n",
               1e-3 * static_cast<double>(h.start_tilt_mdeg.load()), g(h.start_tilt_answers));

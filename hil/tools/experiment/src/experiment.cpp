@@ -32,6 +32,12 @@ Status ExperimentOptions::validate() const {
   return Status::ok();
 }
 
+Isometry3 withStartTiltError(const Isometry3& T_w_c0, double pitch_deg, double roll_deg) {
+  Isometry3 T = T_w_c0;
+  T.linear() = T_w_c0.linear() * expSO3(Eigen::Vector3d(pitch_deg, 0.0, roll_deg) * (M_PI / 180.0));
+  return T;
+}
+
 Expected<RunResult> runRoute(const Route& route, const std::optional<SunSourceSpec>& spec,
                              const ExperimentOptions& options, const FrameObserver& observer) {
   SUNVO_RETURN_IF_ERROR(options.validate());
@@ -64,10 +70,8 @@ Expected<RunResult> runRoute(const Route& route, const std::optional<SunSourceSp
     sao.vertical.enabled = true;
     vertical.emplace(*options.vertical);
   }
-  Isometry3 T_w_c0 = route.T_w_c_gt[0];
-  T_w_c0.linear() = T_w_c0.linear() * expSO3(Eigen::Vector3d(options.start_pitch_error_deg, 0.0,
-                                                             options.start_roll_error_deg) *
-                                             kRad);
+  const Isometry3 T_w_c0 = withStartTiltError(route.T_w_c_gt[0], options.start_pitch_error_deg,
+                                              options.start_roll_error_deg);
   pipeline::SunAidedOdometry odometry;
   SUNVO_RETURN_IF_ERROR(
       odometry.init(sao, route.camera, T_w_c0, pipeline::OdometryInput::kFeatures));

@@ -122,18 +122,9 @@ int main(int argc, char** argv) {
                  "the \"up\" answers of the first N frames measure the world's up (default 0: "
                  "the first camera's -y is up; 50: sunvo_replay's for a first-camera world)")
       ->check(CLI::Range(0, 100000));
-  app.add_option("--start-pitch-error-deg", options.start_pitch_error_deg,
-                 "start VO from the first true pose pitched by this much (a rover's wrongly "
-                 "configured start tilt; evaluated against the true poses), deg")
-      ->check(CLI::Range(-30.0, 30.0));
-  app.add_option("--start-roll-error-deg", options.start_roll_error_deg,
-                 "the same about the optical axis, deg")
-      ->check(CLI::Range(-30.0, 30.0));
   bool level_start = false;
-  app.add_flag("--level-start", level_start,
-               "the \"up\" answers of the first frames (15 unless --world-up-alignment-frames) "
-               "measure the start attitude's tilt error, which is then removed (the rover's "
-               "setting)");
+  sunvo::cli::addStartTiltOptions(app, options.start_pitch_error_deg, options.start_roll_error_deg,
+                                  level_start);
   app.add_flag("--self-calib", self_calib,
                "online stereo self-calibration of the right camera before the odometry");
   sunvo::cli::addSelfCalibrationRateOptions(app, options.self_calibration);

@@ -94,20 +94,11 @@ int main(int argc, char** argv) {
                  "world is the first camera, which nobody levelled; 0 in ENU)")
       ->check(CLI::Range(-1, 100000));
   bool level_start = false;
-  app.add_flag("--level-start", level_start,
-               "the cue's answers of the first frames (15 unless --world-up-alignment-frames) "
-               "measure the start attitude's tilt error, which is then removed (as a rover "
-               "without an INS does; ENU worlds only)");
+  sunvo::cli::addStartTiltOptions(app, options.start_pitch_error_deg, options.start_roll_error_deg,
+                                  level_start);
   app.add_option("--initial-sigma-deg", options.fusion.initial_attitude_sigma_deg,
                  "the start attitude's std, deg (0.1: the first OXTS record's; the rover's 1)")
       ->check(CLI::Range(0.001, 45.0));
-  app.add_option("--start-pitch-error-deg", options.start_pitch_error_deg,
-                 "start VO from the first camera pose pitched by this much (a rover's wrongly "
-                 "configured start tilt; evaluated against the true poses), deg")
-      ->check(CLI::Range(-30.0, 30.0));
-  app.add_option("--start-roll-error-deg", options.start_roll_error_deg,
-                 "the same about the optical axis, deg")
-      ->check(CLI::Range(-30.0, 30.0));
   bool self_calib = false;
   app.add_flag("--self-calib", self_calib,
                "online stereo self-calibration of the right camera (measures the right rows); its "

@@ -2,7 +2,6 @@
 
 #include <cmath>
 
-#include "sunvo/core/geometry.hpp"
 #include "sunvo/kitti/stereo_source.hpp"
 #include "sunvo/metrics/metrics.hpp"
 
@@ -113,11 +112,8 @@ Expected<ReplayRun> replayDrive(const dataset::Dataset& data, const ReplayOption
     SUNVO_RETURN_IF_ERROR(spec->model.validate());
     sun_source.emplace(spec->model);
   }
-  // The start pose, turned by the start attitude error (pitch about x, roll about z of camera 0).
-  Isometry3 T_w_c0 = data.T_w_c0();
-  T_w_c0.linear() = T_w_c0.linear() * expSO3(Eigen::Vector3d(options.start_pitch_error_deg, 0.0,
-                                                             options.start_roll_error_deg) *
-                                             (M_PI / 180.0));
+  const Isometry3 T_w_c0 = experiment::withStartTiltError(
+      data.T_w_c0(), options.start_pitch_error_deg, options.start_roll_error_deg);
   pipeline::SunAidedOdometry vo;
   SUNVO_RETURN_IF_ERROR(vo.init(sao, data.camera(), T_w_c0));
 

@@ -211,6 +211,11 @@ struct SunFusionOptions {
   // Its correlation length, frames, [1, 1e6] (250: a street at 10 m/s and 10 fps).
   double sun_bias_length_frames = 250.0;
 
+  // Whether the first answers level the start (kStartTilt with frames to take them from).
+  bool levelsStartTilt() const {
+    return world_up_alignment_use == WorldUpAlignmentUse::kStartTilt &&
+           world_up_alignment_frames > 0;
+  }
   Status validate() const;
   template <class Self, class V>
   static void fields(Self& s, V& v) {
@@ -289,7 +294,7 @@ class SunWindowTerm {
   // (world_up_alignment_frames > 0, kWorldUp) its estimate; and the alignment's state (with
   // kStartTilt its estimate measured the start's tilt error: tiltDeg()).
   const Eigen::Vector3d& worldUp() const {
-    return levelsStart() ? options_.world_up : world_up_.up();
+    return options_.levelsStartTilt() ? options_.world_up : world_up_.up();
   }
   const WorldUpAlignment& worldUpAlignment() const { return world_up_; }
   // kStartTilt, called before frame `sequence` is processed: once the alignment is done (the
@@ -365,10 +370,6 @@ class SunWindowTerm {
                          const double* delta_b, double db, Eigen::Vector3d* r,
                          Eigen::Matrix<double, 3, 3, Eigen::RowMajor>* J_d, Eigen::Vector3d* J_bias,
                          int* m);
-  bool levelsStart() const {
-    return options_.world_up_alignment_use == WorldUpAlignmentUse::kStartTilt &&
-           options_.world_up_alignment_frames > 0;
-  }
   bool biasEnabled() const {
     return options_.sun_bias_sigma_deg > 0.0 && options_.estimate_base_attitude;
   }

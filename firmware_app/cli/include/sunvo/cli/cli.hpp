@@ -84,6 +84,24 @@ void addRotationRatePriorOptions(CLI::App& app, WindowOptions& win) {
       ->check(CLI::Range(1e-3, 180.0));
 }
 
+// A start attitude wrong in tilt and its levelling (docs/vertical.md, "Levelling the rover's
+// start"), the same in every program that emulates it: --start-pitch-error-deg,
+// --start-roll-error-deg (deg, [-30, 30]: VO starts from the true first pose turned by them) and
+// --level-start (the vertical cue's first answers measure that error, which is then removed).
+inline void addStartTiltOptions(CLI::App& app, double& pitch_error_deg, double& roll_error_deg,
+                                bool& level_start) {
+  app.add_option("--start-pitch-error-deg", pitch_error_deg,
+                 "start VO from the first true pose pitched by this much (a rover's wrongly "
+                 "configured start tilt; evaluated against the true poses), deg")
+      ->check(CLI::Range(-30.0, 30.0));
+  app.add_option("--start-roll-error-deg", roll_error_deg, "the same about the optical axis, deg")
+      ->check(CLI::Range(-30.0, 30.0));
+  app.add_flag("--level-start", level_start,
+               "the vertical cue's answers of the first frames (15 unless "
+               "--world-up-alignment-frames) measure the start attitude's tilt error, which is "
+               "then removed (the rover's setting; worlds whose up is known)");
+}
+
 // A sun azimuth bias state's std (deg) and correlation length (frames) as --<prefix>bias-state-deg
 // and --<prefix>bias-state-frames, with the fusion's ranges; `std_help` describes the std.
 inline void addBiasStateOptions(CLI::App& app, double& sigma_deg, double& length_frames,

@@ -99,6 +99,10 @@ struct RunResult {
   metrics::Evaluation evaluation;
 };
 
+// The first camera pose T_w_c0 turned by a start attitude error, deg: pitch about the camera's x
+// axis, roll about its optical axis (ExperimentOptions/ReplayOptions::start_*_error_deg).
+Isometry3 withStartTiltError(const Isometry3& T_w_c0, double pitch_deg, double roll_deg);
+
 // Called after frame k was processed, with the odometry (its pose, sun counters, attitude
 // covariance): traces and diagnostics (sunvo_fusion_trace).
 using FrameObserver = std::function<void(std::size_t k, const pipeline::SunAidedOdometry&)>;
