@@ -122,5 +122,26 @@ TEST(WorldUpAlignment, TheTiltCorrectionTurnsTheEstimateOntoTheKnownUp) {
   EXPECT_NEAR(a.sigma(), 0.5 * kDeg / std::sqrt(3.0), 1e-9);
 }
 
+// A correction of the attitude the answers were carried by turns them all, and the estimate once
+// it is done: the tilt left is what was seen minus what the fusion has taken out.
+TEST(WorldUpAlignment, AnswersFollowTheCorrectionsOfTheirAttitude) {
+  const Eigen::Vector3d up_w = Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d e(4.0 * kDeg, 0.0, 0.0);
+  WorldUpAlignment a;
+  a.reset(15, up_w);
+  for (std::uint64_t k = 5; k <= 15; k += 5) {
+    ASSERT_TRUE(a.takes(k));
+    a.add(expSO3(-e) * up_w, 0.5 * kDeg);
+  }
+  a.turn(expSO3(Eigen::Vector3d(3.0 * kDeg, 0.0, 0.0)));  // the filter took 3 of the 4 deg
+  a.finishIfPast(16);
+  ASSERT_TRUE(a.done());
+  EXPECT_NEAR(a.tiltDeg(), 1.0, 1e-6);
+  a.turn(expSO3(Eigen::Vector3d(1.0 * kDeg, 0.0, 0.0)));  // and the rest
+  EXPECT_NEAR(a.tiltDeg(), 0.0, 1e-6);
+  a.turn(Eigen::Matrix3d::Constant(NAN));  // not finite: ignored
+  EXPECT_NEAR(a.tiltDeg(), 0.0, 1e-6);
+}
+
 }  // namespace
 }  // namespace sunvo::sunfusion

@@ -137,6 +137,7 @@ Status SunWindowTerm::init(const SunFusionOptions& options) {
   }
   last_sequence_.reset();
   levelled_ = false;
+  start_decided_ = false;
   num_used_ = 0;
   last_correction_ = Correction{};
   num_corrections_ = 0;
@@ -241,9 +242,13 @@ Status SunWindowTerm::onSolve(backend::BundleWindow& window) {
         world_up_.add(window.T_w_b().linear() * window.T_k_b(s).linear().transpose() *
                           p.obs.measurement.sun_c,
                       p.obs.measurement.sigma);
-        p.decided = true;
-        p.accepted = false;
-        continue;
+        // An unknown world's up: the answer is held, it is what the up is measured from. A
+        // start's tilt: the answer is also fused, and the alignment follows the corrections.
+        if (!options_.levelsStartTilt()) {
+          p.decided = true;
+          p.accepted = false;
+          continue;
+        }
       }
       if (r == GateResult::kAccepted && estimate) {
         p.cost = setSunCost(ring, sun_b, p.obs.measurement);
@@ -365,6 +370,8 @@ void SunWindowTerm::onSolved(backend::BundleWindow& window) {
   }
   window.correctBaseAttitude(expSO3(delta_b));
   const Eigen::Vector3d c_w = C_w_b * delta_b;
+  // The answers collected for the start's tilt were carried by the attitude just corrected.
+  if (options_.levelsStartTilt() && !start_decided_) world_up_.turn(expSO3(c_w));
   last_correction_ = {window.sequence(window.size() - 1), c_w, used};
   ++num_corrections_;
   // The evidence sums describe the error left: each innovation r_i ~ H_i e becomes H_i (e - c_w).
@@ -374,18 +381,24 @@ void SunWindowTerm::onSolved(backend::BundleWindow& window) {
 }
 
 std::optional<Eigen::Vector3d> SunWindowTerm::takeStartLevelling(std::uint64_t sequence) {
-  if (!options_.levelsStartTilt() || levelled_) return std::nullopt;
+  if (!options_.levelsStartTilt() || start_decided_) return std::nullopt;
   world_up_.finishIfPast(sequence);
   if (!world_up_.done()) return std::nullopt;
-  levelled_ = true;
-  // The answers measured u_est = C_w_ck up_ck with VO's attitude; the truth is C_w_ck,true =
-  // Exp(e) C_w_ck with Exp(e) u_est = world_up, e normal to both (the heading is not seen).
+  start_decided_ = true;
+  // The answers measured u_est = C_w_ck up_ck with VO's attitude (turned by every correction
+  // since); the truth is C_w_ck,true = Exp(e) C_w_ck with Exp(e) u_est = world_up, e normal to
+  // both (the heading is not seen).
   const Eigen::Vector3d e = world_up_.tiltCorrection();
-  if (!e.allFinite() || !(world_up_.sigma() > 0.0)) return std::nullopt;
+  const double sigma = world_up_.sigma();
+  if (!e.allFinite() || !(sigma > 0.0)) return std::nullopt;
+  // What is left is the filter's to take unless the answers say it is there: e has two dof
+  // (normal to the up), each with the mean's sigma.
+  if (e.squaredNorm() <= kStartTiltChi2 * sigma * sigma) return std::nullopt;
+  levelled_ = true;
   // The tilt part of P is now the estimate's; the heading part (and its bias covariance) stays.
   const Eigen::Vector3d& u = options_.world_up;
   const Eigen::Matrix3d uu = u * u.transpose();
-  const double s2 = world_up_.sigma() * world_up_.sigma();
+  const double s2 = sigma * sigma;
   P_ = uu * P_ * uu + s2 * (Eigen::Matrix3d::Identity() - uu);
   P_tb_ = uu * P_tb_;
   last_correction_ = {sequence, e, world_up_.used()};

@@ -35,6 +35,15 @@ void WorldUpAlignment::add(const Eigen::Vector3d& up_w, double sigma) {
   if (++count_ == kMaxMeasurements) finish();
 }
 
+void WorldUpAlignment::turn(const Eigen::Matrix3d& C) {
+  if (!C.allFinite()) return;
+  for (int i = 0; i < count_; ++i) {
+    Eigen::Vector3d& u = u_[static_cast<std::size_t>(i)];
+    u = (C * u).normalized();
+  }
+  if (done_ && count_ > 0) up_ = (C * up_).normalized();
+}
+
 void WorldUpAlignment::finish() {
   done_ = true;
   if (count_ == 0) return;  // nothing measured: keep the assumed up

@@ -345,8 +345,9 @@ HealthSample RoverApp::healthSample(TimeNs now) const {
   out.poses_published = g(h.poses_published);
   out.source_ended = s.channels.capture_done.load(std::memory_order_acquire);
   out.estimator_done = s.channels.estimator_done.load(std::memory_order_acquire);
-  out.start_tilt_answers = g(h.start_tilt_answers);
+  out.start_tilt_answers = h.start_tilt_answers.load(std::memory_order_acquire);
   out.start_tilt_mdeg = h.start_tilt_mdeg.load(std::memory_order_relaxed);
+  out.start_tilt_removed = h.start_tilt_removed.load(std::memory_order_relaxed);
   return out;
 }
 
@@ -425,8 +426,10 @@ std::string RoverApp::summary() const {
   }
   if (s.config.estimator.fusion.levelsStartTilt()) {
     if (h.start_tilt_answers.load() > 0) {
-      appendf(&o, "  start tilt: %.3f deg measured from %" PRIu64 " cue answers and removed\n",
-              1e-3 * static_cast<double>(h.start_tilt_mdeg.load()), g(h.start_tilt_answers));
+      appendf(
+          &o, "  start tilt: %.3f deg measured from %" PRIu64 " cue answers %s\n",
+          1e-3 * static_cast<double>(h.start_tilt_mdeg.load()), g(h.start_tilt_answers),
+          h.start_tilt_removed.load() ? "and removed" : "(within their noise: left to the filter)");
     } else {
       o += "  start tilt: not levelled (fewer than 3 cue answers)\n";
     }

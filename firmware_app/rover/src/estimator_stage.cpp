@@ -190,11 +190,14 @@ void EstimatorStage::run() {
     const sunfusion::GateCounters& vgate = odometry_.verticalCounters();
     health.vertical_accepted.store(vgate.accepted, std::memory_order_relaxed);
     health.vertical_rejected.store(vgate.total() - vgate.accepted, std::memory_order_relaxed);
-    if (odometry_.sunTerm().startLevelled() && health.start_tilt_answers.load() == 0) {
+    if (odometry_.sunTerm().startTiltJudged() && health.start_tilt_answers.load() == 0) {
       const sunfusion::WorldUpAlignment& level = odometry_.sunTerm().worldUpAlignment();
       health.start_tilt_mdeg.store(std::llround(1e3 * level.tiltDeg()), std::memory_order_relaxed);
-      health.start_tilt_answers.store(static_cast<std::uint64_t>(level.used()),
+      health.start_tilt_removed.store(odometry_.sunTerm().startLevelled(),
                                       std::memory_order_relaxed);
+      // Release: a reader that sees the answers sees the tilt and the decision.
+      health.start_tilt_answers.store(static_cast<std::uint64_t>(level.used()),
+                                      std::memory_order_release);
     }
 
     const PoseRecord pose = poseOf(*r, slot);

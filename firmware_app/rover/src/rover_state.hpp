@@ -87,8 +87,10 @@ struct Health {
   std::atomic<std::uint64_t> vertical_accepted{0};
   std::atomic<std::uint64_t> vertical_rejected{0};
   // fusion.world_up_alignment_use start_tilt: the start's tilt error that the cue's first answers
-  // measured and the estimator removed, millidegrees, and from how many answers (0: not yet).
+  // measured, millidegrees, from how many answers (0: not yet), and whether the estimator removed
+  // it (false: within the answers' noise, left to the filter). Written before the answers.
   std::atomic<std::int64_t> start_tilt_mdeg{0};
+  std::atomic<bool> start_tilt_removed{false};
   std::atomic<std::uint64_t> start_tilt_answers{0};
   std::atomic<std::uint64_t> poses_published{0};
   std::atomic<std::uint64_t> deadline_misses{0};

@@ -23,10 +23,12 @@ std::optional<int> Supervisor::tick(TimeNs now) {
   const HealthSample sample = app_.healthSample(now);
   const HealthFault fault = watch_.update(sample);
   if (!start_tilt_logged_ && sample.start_tilt_answers > 0) {
-    log_.log(runtime::LogPriority::kInfo,
-             "start tilt: %.3f deg measured from %llu vertical-cue answers and removed",
-             static_cast<double>(sample.start_tilt_mdeg) * 1e-3,
-             static_cast<unsigned long long>(sample.start_tilt_answers));
+    log_.log(
+        runtime::LogPriority::kInfo,
+        "start tilt: %.3f deg measured from %llu vertical-cue answers %s",
+        static_cast<double>(sample.start_tilt_mdeg) * 1e-3,
+        static_cast<unsigned long long>(sample.start_tilt_answers),
+        sample.start_tilt_removed ? "and removed" : "(within their noise: left to the filter)");
     start_tilt_logged_ = true;
   }
   if (watch_.clockJumps() != jumps_before) {

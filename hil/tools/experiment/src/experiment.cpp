@@ -106,8 +106,9 @@ Expected<RunResult> runRoute(const Route& route, const std::optional<SunSourceSp
   result.vertical_gate = odometry.verticalCounters();
   result.world_up_answers = odometry.sunTerm().worldUpAlignment().used();
   result.world_up_error_deg = angleBetween(odometry.worldUp(), true_up_w) / kRad;
+  result.start_tilt_judged = odometry.sunTerm().startTiltJudged();
   result.start_levelled = odometry.sunTerm().startLevelled();
-  if (result.start_levelled)
+  if (result.start_tilt_judged)
     result.start_tilt_deg = odometry.sunTerm().worldUpAlignment().tiltDeg();
   result.selfcal_pitch_mrad = odometry.lastSelfCalibration().pitch_mrad;
   result.selfcal_roll_mrad = odometry.lastSelfCalibration().roll_mrad;

@@ -281,9 +281,11 @@ int main(int argc, char** argv) {
                                                      g.rejected_invalid),
                      static_cast<unsigned long long>(g.rejected_innovation));
       }
-      if (run->start_levelled) {
-        std::fprintf(stderr, "    start tilt error %.3f deg measured from %d answers and removed\n",
-                     run->start_tilt_deg, run->world_up_answers);
+      if (run->start_tilt_judged) {
+        std::fprintf(
+            stderr, "    start tilt error %.3f deg measured from %d answers %s\n",
+            run->start_tilt_deg, run->world_up_answers,
+            run->start_levelled ? "and removed" : "(within their noise: left to the filter)");
       } else if (run->world_up_answers > 0) {
         std::fprintf(stderr, "    world's up from %d answers: %.3f deg from the true one\n",
                      run->world_up_answers, run->world_up_error_deg);

@@ -249,10 +249,11 @@ int main(int argc, char** argv) {
                    static_cast<unsigned long long>(run->vertical_gate.accepted),
                    static_cast<unsigned long long>(run->vertical_stats.errors));
     }
-    if (run->start_levelled) {
-      std::fprintf(stderr,
-                   "  %-28s start tilt error %.3f deg measured from %d cue answers and removed\n",
-                   "", run->world_up_tilt_deg, run->world_up_answers);
+    if (run->start_tilt_judged) {
+      std::fprintf(
+          stderr, "  %-28s start tilt error %.3f deg measured from %d cue answers %s\n", "",
+          run->world_up_tilt_deg, run->world_up_answers,
+          run->start_levelled ? "and removed" : "(within their noise: left to the filter)");
     } else if (run->world_up_answers > 0) {
       std::fprintf(stderr,
                    "  %-28s world's up (%.4f, %.4f, %.4f) from %d cue answers: %.3f deg off the "

@@ -186,6 +186,7 @@ Expected<ReplayRun> replayDrive(const dataset::Dataset& data, const ReplayOption
   run.world_up_answers = vo.sunTerm().worldUpAlignment().used();
   run.world_up_tilt_deg = vo.sunTerm().worldUpAlignment().tiltDeg();
   run.world_up = vo.worldUp();
+  run.start_tilt_judged = vo.sunTerm().startTiltJudged();
   run.start_levelled = vo.sunTerm().startLevelled();
   run.median_ms = metrics::percentile(ms, 0.5);
   run.p99_ms = metrics::percentile(ms, 0.99);

@@ -128,9 +128,11 @@ inline std::span<const std::string_view> enumNames(DriftAdaptation) {
 //    estimate becomes the world's up of the vertical channel, its gate and the walk's split.
 //  kStartTilt: VO's tilt error at the start, where the world's up is known (ENU) but the start
 //    attitude's roll and pitch are not (a rover parked on a slope and started with the configured
-//    ones): VO's attitude is turned by the rotation that takes the estimate onto world_up (roll
-//    and pitch only), together with the positions built since the first frame, and the tilt part
-//    of the attitude covariance becomes the estimate's. world_up stays the world's up.
+//    ones). The answers are fused as they come, and collected beside; what the filter has left of
+//    the error after those frames, where significant (kStartTiltChi2), is removed at once: VO's
+//    attitude is turned by the rotation that takes the estimate onto world_up (roll and pitch
+//    only), together with the positions built since the first frame, and the tilt part of the
+//    attitude covariance becomes the estimate's. world_up stays the world's up.
 enum class WorldUpAlignmentUse { kWorldUp, kStartTilt };
 inline std::span<const std::string_view> enumNames(WorldUpAlignmentUse) {
   static constexpr std::string_view kNames[] = {"world_up", "start_tilt"};
@@ -260,6 +262,13 @@ inline constexpr int kWorldUpAlignmentFrames = 50;
 // against 50 on validation drives (docs/vertical.md, "Levelling the rover's start").
 inline constexpr int kStartTiltFrames = 15;
 
+// Significance of the start's tilt error left after those frames: chi-square with two degrees of
+// freedom at 99 % (3.03 sigma of the answers' mean). Below it the turn would add the mean's noise
+// to an estimate the filter has already taken the answers into; above it the filter was not
+// taking them (an attitude covariance too small for the start's error refuses them at the
+// innovation gate).
+inline constexpr double kStartTiltChi2 = 9.21;
+
 // The fusion's settings for an image sun estimator (Sun-CNN, Lalonde, Lalonde-VO), whose errors
 // stay alike for a street and can be biased for a whole drive; sunvo_replay's image-estimator
 // options and the rover's estimator defaults start from these.
@@ -298,11 +307,16 @@ class SunWindowTerm {
   }
   const WorldUpAlignment& worldUpAlignment() const { return world_up_; }
   // kStartTilt, called before frame `sequence` is processed: once the alignment is done (the
-  // frame is past its frames and enough answers were taken), the world-frame rotation vector e
-  // (rad) by which the caller must turn VO's world poses, C_w_c <- Exp(e) C_w_c, and the
-  // positions built since the first frame about it (the error was there from the start); the tilt
-  // part of the attitude covariance becomes the estimate's. Given once; nullopt otherwise.
+  // frame is past its frames and enough answers were taken), the tilt error its answers measure
+  // (what the filter, which fused them too, left of the start's error) is judged against the
+  // mean's sigma. Where it is significant (|e|^2 > kStartTiltChi2 sigma^2), the world-frame
+  // rotation vector e (rad) by which the caller must turn VO's world poses, C_w_c <- Exp(e)
+  // C_w_c, and the positions built since the first frame about it; the tilt part of the attitude
+  // covariance becomes the estimate's. Given once; nullopt otherwise.
   std::optional<Eigen::Vector3d> takeStartLevelling(std::uint64_t sequence);
+  // The start's tilt was judged (startTiltJudged) and removed (startLevelled); the measured tilt
+  // is worldUpAlignment().tiltDeg(), its sigma worldUpAlignment().sigma().
+  bool startTiltJudged() const { return start_decided_; }
   bool startLevelled() const { return levelled_; }
 
   const GateCounters& counters() const { return counters_; }
@@ -437,7 +451,8 @@ class SunWindowTerm {
   double persistence_T_ = 0.0;
   std::array<double, 4> persistence_bound_{};  // chi-square quantile by rank 1..3
   std::optional<std::uint64_t> last_sequence_;
-  bool levelled_ = false;  // kStartTilt: the start was levelled (takeStartLevelling)
+  bool start_decided_ = false;  // kStartTilt: the alignment is done and its tilt was judged
+  bool levelled_ = false;       // kStartTilt: the start was levelled (takeStartLevelling)
   AttitudePriorResidual* prior_ = nullptr;  // owned by prior_cost_
   std::unique_ptr<ceres::CostFunction> prior_cost_;
   AttitudeBiasPriorResidual* bias_prior_ = nullptr;  // owned by bias_prior_cost_

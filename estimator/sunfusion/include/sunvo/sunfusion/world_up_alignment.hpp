@@ -21,7 +21,10 @@
 // The same answers serve a world whose up is known (ENU) but whose start attitude is not level
 // as configured (a rover parked on a slope): there their mean measures VO's tilt error at the
 // start, tiltCorrection() is the rotation that removes it, and the fusion turns VO's world by it
-// (SunFusionOptions::world_up_alignment_use kStartTilt).
+// (SunFusionOptions::world_up_alignment_use kStartTilt). There the answers are also fused while
+// they are collected, and each correction the fusion makes turns the estimate they were carried
+// by: turn() carries them along, so that at the end their mean measures the tilt error that is
+// left, not the one at the start.
 //
 // No allocation: at most kMaxMeasurements answers are kept.
 
@@ -46,6 +49,9 @@ class WorldUpAlignment {
   // An answer: up_w = C_w_ck up_ck (unit), sigma its 1-sigma angle (rad, > 0). Call after
   // takes() said yes. Finishes when the store is full.
   void add(const Eigen::Vector3d& up_w, double sigma);
+  // The attitude estimate the answers were carried by was turned, C_w_c <- C C_w_c (a fusion
+  // correction): u_w,i <- C u_w,i for every answer, and the estimate once done.
+  void turn(const Eigen::Matrix3d& C);
 
   bool done() const { return done_; }
   // The world's up: the assumed one until done, then the estimate.

@@ -36,10 +36,12 @@ struct HealthSample {
   std::uint64_t poses_published = 0;
   bool source_ended = false;    // the capture loop has finished (end of a replay, or stop)
   bool estimator_done = false;  // the estimator loop has finished
-  // The start's tilt error the cue's first answers measured and the estimator removed
-  // (fusion.world_up_alignment_use start_tilt), millidegrees, and from how many answers (0: not
-  // levelled yet). An event, not a fault: the supervisor logs it once.
+  // The start's tilt error the cue's first answers measured (fusion.world_up_alignment_use
+  // start_tilt), millidegrees, from how many answers (0: not judged yet), and whether the
+  // estimator removed it (false: within the answers' noise, left to the filter). An event, not a
+  // fault: the supervisor logs it once.
   std::int64_t start_tilt_mdeg = 0;
+  bool start_tilt_removed = false;
   std::uint64_t start_tilt_answers = 0;
 };
 

@@ -87,8 +87,9 @@ struct RunResult {
   metrics::TiltMetrics tilt;              // attitude error split into tilt and heading
   int world_up_answers = 0;               // "up" answers that measured the world's up (if aligned)
   double world_up_error_deg = 0.0;  // angle of the world's up in use from the route's true one
-  bool start_levelled = false;      // kStartTilt: the start's tilt error was measured and removed
-  double start_tilt_deg = 0.0;      // the tilt error the "up" answers measured, deg
+  bool start_tilt_judged = false;   // kStartTilt: the "up" answers measured the start's tilt error
+  bool start_levelled = false;      // and it was significant and removed
+  double start_tilt_deg = 0.0;      // the tilt error the answers measured, deg
   int lost_frames = 0;
   double median_ms = 0.0;  // VO time per frame (association, RANSAC, window), median
   double p99_ms = 0.0;

@@ -83,7 +83,10 @@ struct ReplayRun {
   int world_up_answers = 0;        // cue answers that measured the world's up (if aligned)
   double world_up_tilt_deg = 0.0;  // the estimate's angle from the assumed up, deg
   Eigen::Vector3d world_up = Eigen::Vector3d::Zero();  // the world's up in use at the end
-  bool start_levelled = false;  // the answers measured the start's tilt error, which was removed
+  // start_tilt: the answers measured the start's tilt error (world_up_tilt_deg), which was judged
+  // and, where significant, removed.
+  bool start_tilt_judged = false;
+  bool start_levelled = false;
   int lost_frames = 0;
   double median_ms = 0.0;  // pipeline time per frame
   double p99_ms = 0.0;
