@@ -235,6 +235,40 @@ TEST(Experiment, AStartTiltTheFilterTakesIsLeftToIt) {
               judged->tilt.tilt_rms_rad * 180.0 / M_PI);
 }
 
+// A start 12 deg off, beyond the vertical channel's 10 deg gate: no answer is fused, and the
+// levelling measures it only because it collects up to start_tilt_max_deg (15); with that bound
+// at 10 it sees nothing either.
+TEST(Experiment, AStartBeyondTheCueGateIsMeasuredUpToItsOwnBound) {
+  SimulatedRouteOptions sim;
+  sim.seed = 7;
+  auto route = loadRoute("06", kData, sim);
+  ASSERT_TRUE(route) << route.status().toString();
+  ExperimentOptions opt;
+  opt.vo.window.max_solver_time_in_seconds = 60.0;
+  opt.max_frames = 150;
+  opt.fusion.initial_attitude_sigma_deg = 1.0;
+  opt.start_pitch_error_deg = 12.0;
+  opt.vertical = verticalLikeUp();
+  opt.fusion.world_up_alignment_use = sunfusion::WorldUpAlignmentUse::kStartTilt;
+  opt.fusion.world_up_alignment_frames = sunfusion::kStartTiltFrames;
+  opt.fusion.start_tilt_max_deg = 10.0;
+  auto blind = runRoute(*route, std::nullopt, opt);
+  ASSERT_TRUE(blind) << blind.status().toString();
+  EXPECT_FALSE(blind->start_levelled);
+  EXPECT_GT(blind->tilt.tilt_final_rad * 180.0 / M_PI, 10.0);
+  opt.fusion.start_tilt_max_deg = 15.0;
+  auto levelled = runRoute(*route, std::nullopt, opt);
+  ASSERT_TRUE(levelled) << levelled.status().toString();
+  EXPECT_TRUE(levelled->start_levelled);
+  EXPECT_NEAR(levelled->start_tilt_deg, 12.0, 1.5);
+  EXPECT_LT(levelled->tilt.tilt_final_rad * 180.0 / M_PI, 1.0);
+  std::printf(
+      "start pitched 12 deg: final tilt %.3f deg unmeasured, %.3f deg levelled (%.3f "
+      "measured)\n",
+      blind->tilt.tilt_final_rad * 180.0 / M_PI, levelled->tilt.tilt_final_rad * 180.0 / M_PI,
+      levelled->start_tilt_deg);
+}
+
 TEST(Experiment, SimulatedRouteUsesTheRealGroundTruthAndSun) {
   SimulatedRouteOptions sim;
   auto route = loadRoute("06", kData, sim);

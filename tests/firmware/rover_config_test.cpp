@@ -48,7 +48,7 @@ TEST(RoverConfig, TheShippedConfigsLoad) {
   // The vertical cue, in the sun thread, with time to answer (docs/vertical.md).
   EXPECT_TRUE(rover->estimator.vertical.enabled);
   EXPECT_GE(rover->realtime.sun_wait_ms, 20.0);
-  // Its first three answers level the start (docs/vertical.md, "Levelling the rover's start"); the
+  // Its first three answers level the start (docs/start_levelling.md); the
   // replay file starts from the drive's OXTS pose and does not.
   EXPECT_EQ(rover->estimator.fusion.world_up_alignment_use,
             sunfusion::WorldUpAlignmentUse::kStartTilt);

@@ -223,7 +223,7 @@ TEST(RoverReplay, VerticalCueInTheSunThread) {
 }
 
 // The start levelled from the cue's first three answers (config/rover.yaml's setting,
-// docs/vertical.md "Levelling the rover's start"): the answers of frames 5, 10 and 15 measure the
+// docs/start_levelling.md): the answers of frames 5, 10 and 15 measure the
 // start's tilt error, and the summary and the journal report it. The replay starts from the
 // drive's OXTS pose, so the error is small, within the answers' noise, and left to the filter.
 TEST(RoverReplay, StartLevelledFromTheCue) {

@@ -583,6 +583,8 @@ TEST(SunFusionOptionsTest, ValidationNamesTheBadKey) {
       {[](SunFusionOptions& o) { o.max_correction_deg = -1.0; }, "max_correction_deg"},
       {[](SunFusionOptions& o) { o.sun_bias_sigma_deg = 50.0; }, "sun_bias_sigma_deg"},
       {[](SunFusionOptions& o) { o.sun_bias_length_frames = 0.0; }, "sun_bias_length_frames"},
+      {[](SunFusionOptions& o) { o.start_tilt_max_deg = 0.0; }, "start_tilt_max_deg"},
+      {[](SunFusionOptions& o) { o.start_tilt_max_deg = 46.0; }, "start_tilt_max_deg"},
   };
   for (const auto& [set, key] : cases) {
     SunFusionOptions opt;

@@ -38,73 +38,6 @@ double chiSquareQuantile(double p, int dof) {
 }
 }  // namespace
 
-Status SunFusionOptions::validate() const {
-  SUNVO_RETURN_IF_ERROR(gate.validate());
-  if (const Status s = vertical_gate.validate(); !s.isOk()) {
-    return invalidArgument("fusion.vertical_gate: " + s.message());
-  }
-  if (!world_up.allFinite() || std::abs(world_up.norm() - 1.0) > 1e-6) {
-    return invalidArgument("fusion.world_up must be a unit vector");
-  }
-  if (!(world_up_alignment_frames >= 0 && world_up_alignment_frames <= 100000)) {
-    return invalidArgument("fusion.world_up_alignment_frames out of range [0, 100000]");
-  }
-  if (!(loss_scale >= 0.0 && loss_scale <= 100.0)) {
-    return invalidArgument("fusion.loss_scale out of range [0, 100]");
-  }
-  if (!(initial_attitude_sigma_deg > 0.0 && initial_attitude_sigma_deg <= 45.0)) {
-    return invalidArgument("fusion.initial_attitude_sigma_deg out of range (0, 45]");
-  }
-  if (!(attitude_drift_deg_per_frame >= 0.0 && attitude_drift_deg_per_frame <= 5.0)) {
-    return invalidArgument("fusion.attitude_drift_deg_per_frame out of range [0, 5]");
-  }
-  if (!(min_drift_deg_per_frame >= 0.0 && min_drift_deg_per_frame <= max_drift_deg_per_frame &&
-        max_drift_deg_per_frame <= 5.0)) {
-    return invalidArgument(
-        "fusion.min_drift_deg_per_frame / max_drift_deg_per_frame: need 0 <= min <= max <= 5");
-  }
-  if (!(drift_adaptation_rate > 0.0 && drift_adaptation_rate <= 1.0)) {
-    return invalidArgument("fusion.drift_adaptation_rate out of range (0, 1]");
-  }
-  if (!(persistence_forgetting > 0.0 && persistence_forgetting < 1.0)) {
-    return invalidArgument("fusion.persistence_forgetting out of range (0, 1)");
-  }
-  if (!(persistence_false_alarm > 0.0 && persistence_false_alarm <= 0.5)) {
-    return invalidArgument("fusion.persistence_false_alarm out of range (0, 0.5]");
-  }
-  if (!(persistence_step_up > 0.0 && persistence_step_up <= 2.0)) {
-    return invalidArgument("fusion.persistence_step_up out of range (0, 2]");
-  }
-  if (!(persistence_step_down > 0.0 && persistence_step_down <= 2.0)) {
-    return invalidArgument("fusion.persistence_step_down out of range (0, 2]");
-  }
-  if (!(persistence_huber > 0.0 && persistence_huber <= 100.0)) {
-    return invalidArgument("fusion.persistence_huber out of range (0, 100]");
-  }
-  if (!(innovation_gate_chi2 >= 0.0 && innovation_gate_chi2 <= 1e6)) {
-    return invalidArgument("fusion.innovation_gate_chi2 out of range [0, 1e6]");
-  }
-  if (!(evidence_sigmas > 0.0 && evidence_sigmas <= 100.0)) {
-    return invalidArgument("fusion.evidence_sigmas out of range (0, 100]");
-  }
-  if (!(evidence_forgetting > 0.0 && evidence_forgetting < 1.0)) {
-    return invalidArgument("fusion.evidence_forgetting out of range (0, 1)");
-  }
-  if (!(evidence_correlation >= 1.0 && evidence_correlation <= 1000.0)) {
-    return invalidArgument("fusion.evidence_correlation out of range [1, 1000]");
-  }
-  if (!(max_correction_deg >= 0.0 && max_correction_deg <= 180.0)) {
-    return invalidArgument("fusion.max_correction_deg out of range [0, 180]");
-  }
-  if (!(sun_bias_sigma_deg >= 0.0 && sun_bias_sigma_deg <= 45.0)) {
-    return invalidArgument("fusion.sun_bias_sigma_deg out of range [0, 45]");
-  }
-  if (!(sun_bias_length_frames >= 1.0 && sun_bias_length_frames <= 1e6)) {
-    return invalidArgument("fusion.sun_bias_length_frames out of range [1, 1e6]");
-  }
-  return Status::ok();
-}
-
 Status SunWindowTerm::init(const SunFusionOptions& options) {
   SUNVO_RETURN_IF_ERROR(options.validate());
   options_ = options;
@@ -144,6 +77,9 @@ Status SunWindowTerm::init(const SunFusionOptions& options) {
   last_nis_ = 0.0;
   num_inflations_ = 0;
   world_up_.reset(static_cast<std::uint64_t>(options.world_up_alignment_frames), options.world_up);
+  start_gate_ = options.vertical_gate;
+  start_gate_.max_cosine_distance = std::max(options.vertical_gate.max_cosine_distance,
+                                             1.0 - std::cos(options.start_tilt_max_deg * kDeg));
   // Every cost a slot can need, in the form the options ask for (the only allocations).
   const SunResidualForm form = !options.estimate_base_attitude ? SunResidualForm::kPaper
                                : biasEnabled() ? SunResidualForm::kBaseCorrectionAndBias
@@ -237,7 +173,13 @@ Status SunWindowTerm::onSolve(backend::BundleWindow& window) {
       const double up = sun_w.dot(worldUp());
       GateResult r = gateSunMeasurement(channel == 0 ? options_.gate : options_.vertical_gate,
                                         predicted_c, up, p.obs.measurement);
-      if (aligning && r == GateResult::kAccepted) {
+      // A start's tilt is measured up to start_tilt_max_deg, wider than the channel's gate.
+      const bool collect =
+          aligning && (options_.levelsStartTilt()
+                           ? gateSunMeasurement(start_gate_, predicted_c, up, p.obs.measurement) ==
+                                 GateResult::kAccepted
+                           : r == GateResult::kAccepted);
+      if (collect) {
         // up_w = C_w_b C_b_k up_k.
         world_up_.add(window.T_w_b().linear() * window.T_k_b(s).linear().transpose() *
                           p.obs.measurement.sun_c,

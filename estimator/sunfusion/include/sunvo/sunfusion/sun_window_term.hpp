@@ -160,6 +160,11 @@ struct SunFusionOptions {
   int world_up_alignment_frames = 0;
   // What those answers measure (above): the world's up, or VO's tilt error at the start.
   WorldUpAlignmentUse world_up_alignment_use = WorldUpAlignmentUse::kWorldUp;
+  // deg, (0, 45]: kStartTilt: the largest start tilt error whose answers the levelling takes
+  // (vertical_gate's cosine bound replaced by this one while the answers are collected; they are
+  // fused only inside vertical_gate). 15 = the cue's own search around the predicted up
+  // (vertical.max_tilt_deg); a slope steeper than that is not measured.
+  double start_tilt_max_deg = 15.0;
   // Robust loss on the whitened sun residual: Cauchy scale in sigmas, (0, 100]; 0 = no loss.
   double loss_scale = 0.0;
   // Estimate a correction of the base's world attitude (see above); false = the paper's form.
@@ -225,6 +230,7 @@ struct SunFusionOptions {
     v("vertical_gate", s.vertical_gate);
     v("world_up_alignment_frames", s.world_up_alignment_frames);
     v("world_up_alignment_use", s.world_up_alignment_use);
+    v("start_tilt_max_deg", s.start_tilt_max_deg);
     v("loss_scale", s.loss_scale);
     v("estimate_base_attitude", s.estimate_base_attitude);
     v("initial_attitude_sigma_deg", s.initial_attitude_sigma_deg);
@@ -259,7 +265,7 @@ inline constexpr int kWorldUpAlignmentFrames = 50;
 // world_up_alignment_frames for kStartTilt (a rover's start): the fewest frames that give the
 // alignment its three answers at one every fifth frame. The levelling only has to bring the
 // start's tilt error inside the gates; the filter refines it with every later answer. Chosen
-// against 50 on validation drives (docs/vertical.md, "Levelling the rover's start").
+// against 50 on validation drives (docs/start_levelling.md).
 inline constexpr int kStartTiltFrames = 15;
 
 // Significance of the start's tilt error left after those frames: chi-square with two degrees of
@@ -451,6 +457,7 @@ class SunWindowTerm {
   double persistence_T_ = 0.0;
   std::array<double, 4> persistence_bound_{};  // chi-square quantile by rank 1..3
   std::optional<std::uint64_t> last_sequence_;
+  SunGateOptions start_gate_;   // kStartTilt: vertical_gate with start_tilt_max_deg's bound
   bool start_decided_ = false;  // kStartTilt: the alignment is done and its tilt was judged
   bool levelled_ = false;       // kStartTilt: the start was levelled (takeStartLevelling)
   AttitudePriorResidual* prior_ = nullptr;  // owned by prior_cost_

@@ -84,10 +84,10 @@ void addRotationRatePriorOptions(CLI::App& app, WindowOptions& win) {
       ->check(CLI::Range(1e-3, 180.0));
 }
 
-// A start attitude wrong in tilt and its levelling (docs/vertical.md, "Levelling the rover's
-// start"), the same in every program that emulates it: --start-pitch-error-deg,
-// --start-roll-error-deg (deg, [-30, 30]: VO starts from the true first pose turned by them) and
-// --level-start (the vertical cue's first answers measure that error, which is then removed).
+// A start attitude wrong in tilt and its levelling (docs/start_levelling.md), the same in every
+// program that emulates it: --start-pitch-error-deg, --start-roll-error-deg (deg, [-30, 30]: VO
+// starts from the true first pose turned by them) and --level-start (the vertical cue's first
+// answers measure that error, which is then removed where the filter has not taken it).
 inline void addStartTiltOptions(CLI::App& app, double& pitch_error_deg, double& roll_error_deg,
                                 bool& level_start) {
   app.add_option("--start-pitch-error-deg", pitch_error_deg,
@@ -98,8 +98,9 @@ inline void addStartTiltOptions(CLI::App& app, double& pitch_error_deg, double& 
       ->check(CLI::Range(-30.0, 30.0));
   app.add_flag("--level-start", level_start,
                "the vertical cue's answers of the first frames (15 unless "
-               "--world-up-alignment-frames) measure the start attitude's tilt error, which is "
-               "then removed (the rover's setting; worlds whose up is known)");
+               "--world-up-alignment-frames) measure the start attitude's tilt error; what the "
+               "filter has not taken of it by then is removed where significant (the rover's "
+               "setting; worlds whose up is known)");
 }
 
 // A sun azimuth bias state's std (deg) and correlation length (frames) as --<prefix>bias-state-deg
