@@ -130,6 +130,27 @@ sunfusion::VerticalErrorModel verticalLikeUp() {
   return up;
 }
 
+// The start-tilt tests: route 06 (seed 7) with that "up", the rover's 1 deg start sigma, its first
+// `frames` frames started pitched by `pitch_deg`; `level`: the rover's start levelling.
+ExperimentOptions tiltedStart(int frames, double pitch_deg, bool level) {
+  ExperimentOptions opt;
+  opt.vo.window.max_solver_time_in_seconds = 60.0;
+  opt.max_frames = frames;
+  opt.fusion.initial_attitude_sigma_deg = 1.0;
+  opt.start_pitch_error_deg = pitch_deg;
+  opt.vertical = verticalLikeUp();
+  if (level) {
+    opt.fusion.world_up_alignment_use = sunfusion::WorldUpAlignmentUse::kStartTilt;
+    opt.fusion.world_up_alignment_frames = sunfusion::kStartTiltFrames;
+  }
+  return opt;
+}
+Expected<Route> route06Seed7() {
+  SimulatedRouteOptions sim;
+  sim.seed = 7;
+  return loadRoute("06", kData, sim);
+}
+
 // A first camera that was not level (1.2 deg pitch, -1.4 deg roll, the vertical cue's reading on
 // the 11 real KITTI 00 frames): route 06 with `sunvo_experiment --seed 1 --vertical
 // --true-up-pitch-deg 1.2 --true-up-roll-deg -1.4 [--world-up-alignment-frames 0]`. Told that
@@ -170,22 +191,12 @@ TEST(Experiment, AnUnlevelledFirstCameraIsAlignedNotFollowed) {
 // late) the error is gone from then on (RMS 2.95 deg, all of it before the levelling; final 0.28
 // deg; 7.95 deg measured).
 TEST(Experiment, AWrongStartTiltIsLevelledFromTheUp) {
-  SimulatedRouteOptions sim;
-  sim.seed = 7;
-  auto route = loadRoute("06", kData, sim);
+  auto route = route06Seed7();
   ASSERT_TRUE(route) << route.status().toString();
-  ExperimentOptions opt;
-  opt.vo.window.max_solver_time_in_seconds = 60.0;
-  opt.max_frames = 300;
-  opt.fusion.initial_attitude_sigma_deg = 1.0;
-  opt.start_pitch_error_deg = 8.0;
-  opt.vertical = verticalLikeUp();
-  auto stuck = runRoute(*route, std::nullopt, opt);
+  auto stuck = runRoute(*route, std::nullopt, tiltedStart(300, 8.0, false));
   ASSERT_TRUE(stuck) << stuck.status().toString();
   EXPECT_FALSE(stuck->start_levelled);
-  opt.fusion.world_up_alignment_use = sunfusion::WorldUpAlignmentUse::kStartTilt;
-  opt.fusion.world_up_alignment_frames = sunfusion::kStartTiltFrames;
-  auto levelled = runRoute(*route, std::nullopt, opt);
+  auto levelled = runRoute(*route, std::nullopt, tiltedStart(300, 8.0, true));
   ASSERT_TRUE(levelled) << levelled.status().toString();
   EXPECT_TRUE(levelled->start_tilt_judged);
   EXPECT_TRUE(levelled->start_levelled);
@@ -209,21 +220,11 @@ TEST(Experiment, AWrongStartTiltIsLevelledFromTheUp) {
 // they come, leave a tilt within their mean's noise after 15 frames, which is judged and left to
 // the filter. The run is the unlevelled one to the bit.
 TEST(Experiment, AStartTiltTheFilterTakesIsLeftToIt) {
-  SimulatedRouteOptions sim;
-  sim.seed = 7;
-  auto route = loadRoute("06", kData, sim);
+  auto route = route06Seed7();
   ASSERT_TRUE(route) << route.status().toString();
-  ExperimentOptions opt;
-  opt.vo.window.max_solver_time_in_seconds = 60.0;
-  opt.max_frames = 150;
-  opt.fusion.initial_attitude_sigma_deg = 1.0;
-  opt.start_pitch_error_deg = 3.0;
-  opt.vertical = verticalLikeUp();
-  auto plain = runRoute(*route, std::nullopt, opt);
+  auto plain = runRoute(*route, std::nullopt, tiltedStart(150, 3.0, false));
   ASSERT_TRUE(plain) << plain.status().toString();
-  opt.fusion.world_up_alignment_use = sunfusion::WorldUpAlignmentUse::kStartTilt;
-  opt.fusion.world_up_alignment_frames = sunfusion::kStartTiltFrames;
-  auto judged = runRoute(*route, std::nullopt, opt);
+  auto judged = runRoute(*route, std::nullopt, tiltedStart(150, 3.0, true));
   ASSERT_TRUE(judged) << judged.status().toString();
   EXPECT_TRUE(judged->start_tilt_judged);
   EXPECT_FALSE(judged->start_levelled);
@@ -239,18 +240,9 @@ TEST(Experiment, AStartTiltTheFilterTakesIsLeftToIt) {
 // levelling measures it only because it collects up to start_tilt_max_deg (15); with that bound
 // at 10 it sees nothing either.
 TEST(Experiment, AStartBeyondTheCueGateIsMeasuredUpToItsOwnBound) {
-  SimulatedRouteOptions sim;
-  sim.seed = 7;
-  auto route = loadRoute("06", kData, sim);
+  auto route = route06Seed7();
   ASSERT_TRUE(route) << route.status().toString();
-  ExperimentOptions opt;
-  opt.vo.window.max_solver_time_in_seconds = 60.0;
-  opt.max_frames = 150;
-  opt.fusion.initial_attitude_sigma_deg = 1.0;
-  opt.start_pitch_error_deg = 12.0;
-  opt.vertical = verticalLikeUp();
-  opt.fusion.world_up_alignment_use = sunfusion::WorldUpAlignmentUse::kStartTilt;
-  opt.fusion.world_up_alignment_frames = sunfusion::kStartTiltFrames;
+  ExperimentOptions opt = tiltedStart(150, 12.0, true);
   opt.fusion.start_tilt_max_deg = 10.0;
   auto blind = runRoute(*route, std::nullopt, opt);
   ASSERT_TRUE(blind) << blind.status().toString();
