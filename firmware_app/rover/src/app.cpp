@@ -431,7 +431,8 @@ std::string RoverApp::summary() const {
           1e-3 * static_cast<double>(h.start_tilt_mdeg.load()), g(h.start_tilt_answers),
           h.start_tilt_removed.load() ? "and removed" : "(within their noise: left to the filter)");
     } else {
-      o += "  start tilt: not levelled (fewer than 3 cue answers)\n";
+      o += "  start tilt: not measured (fewer than 3 cue answers within "
+           "fusion.start_tilt_max_deg of the configured tilt)\n";
     }
   }
   if (s.telemetry->link() != nullptr)
