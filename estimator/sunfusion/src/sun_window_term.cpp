@@ -185,8 +185,10 @@ Status SunWindowTerm::onSolve(backend::BundleWindow& window) {
                           p.obs.measurement.sun_c,
                       p.obs.measurement.sigma);
         // An unknown world's up: the answer is held, it is what the up is measured from. A
-        // start's tilt: the answer is also fused, and the alignment follows the corrections.
-        if (!options_.levelsStartTilt()) {
+        // start's tilt: the answer is also fused, and the alignment follows the corrections of
+        // the base attitude (onSolved); the paper's form corrects none (it moves the relative
+        // rotations), so there the answer is held too.
+        if (!options_.levelsStartTilt() || !estimate) {
           p.decided = true;
           p.accepted = false;
           continue;

@@ -128,7 +128,8 @@ inline std::span<const std::string_view> enumNames(DriftAdaptation) {
 //    estimate becomes the world's up of the vertical channel, its gate and the walk's split.
 //  kStartTilt: VO's tilt error at the start, where the world's up is known (ENU) but the start
 //    attitude's roll and pitch are not (a rover parked on a slope and started with the configured
-//    ones). The answers are fused as they come, and collected beside; what the filter has left of
+//    ones). The answers are fused as they come (held in the paper's form, which corrects no base
+//    attitude the alignment could follow), and collected beside; what the filter has left of
 //    the error after those frames, where significant (kStartTiltChi2), is removed at once: VO's
 //    attitude is turned by the rotation that takes the estimate onto world_up (roll and pitch
 //    only), together with the positions built since the first frame, and the tilt part of the
