@@ -77,9 +77,12 @@ Status SunWindowTerm::init(const SunFusionOptions& options) {
   last_nis_ = 0.0;
   num_inflations_ = 0;
   world_up_.reset(static_cast<std::uint64_t>(options.world_up_alignment_frames), options.world_up);
-  start_gate_ = options.vertical_gate;
-  start_gate_.max_cosine_distance = std::max(options.vertical_gate.max_cosine_distance,
-                                             1.0 - std::cos(options.start_tilt_max_deg * kDeg));
+  alignment_gate_ = options.vertical_gate;
+  if (options.levelsStartTilt()) {
+    alignment_gate_.max_cosine_distance =
+        std::max(options.vertical_gate.max_cosine_distance,
+                 1.0 - std::cos(options.start_tilt_max_deg * kDeg));
+  }
   // Every cost a slot can need, in the form the options ask for (the only allocations).
   const SunResidualForm form = !options.estimate_base_attitude ? SunResidualForm::kPaper
                                : biasEnabled() ? SunResidualForm::kBaseCorrectionAndBias
@@ -174,12 +177,8 @@ Status SunWindowTerm::onSolve(backend::BundleWindow& window) {
       GateResult r = gateSunMeasurement(channel == 0 ? options_.gate : options_.vertical_gate,
                                         predicted_c, up, p.obs.measurement);
       // A start's tilt is measured up to start_tilt_max_deg, wider than the channel's gate.
-      const bool collect =
-          aligning && (options_.levelsStartTilt()
-                           ? gateSunMeasurement(start_gate_, predicted_c, up, p.obs.measurement) ==
-                                 GateResult::kAccepted
-                           : r == GateResult::kAccepted);
-      if (collect) {
+      if (aligning && gateSunMeasurement(alignment_gate_, predicted_c, up, p.obs.measurement) ==
+                          GateResult::kAccepted) {
         // up_w = C_w_b C_b_k up_k.
         world_up_.add(window.T_w_b().linear() * window.T_k_b(s).linear().transpose() *
                           p.obs.measurement.sun_c,

@@ -426,10 +426,9 @@ std::string RoverApp::summary() const {
   }
   if (s.config.estimator.fusion.levelsStartTilt()) {
     if (h.start_tilt_answers.load() > 0) {
-      appendf(
-          &o, "  start tilt: %.3f deg measured from %" PRIu64 " cue answers %s\n",
-          1e-3 * static_cast<double>(h.start_tilt_mdeg.load()), g(h.start_tilt_answers),
-          h.start_tilt_removed.load() ? "and removed" : "(within their noise: left to the filter)");
+      appendf(&o, "  start tilt: %.3f deg measured from %" PRIu64 " cue answers %s\n",
+              1e-3 * static_cast<double>(h.start_tilt_mdeg.load()), g(h.start_tilt_answers),
+              sunfusion::startTiltOutcome(h.start_tilt_removed.load()));
     } else {
       o += "  start tilt: not measured (fewer than 3 cue answers within "
            "fusion.start_tilt_max_deg of the configured tilt)\n";

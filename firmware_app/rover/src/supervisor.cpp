@@ -1,5 +1,7 @@
 #include "sunvo/rover/supervisor.hpp"
 
+#include "sunvo/sunfusion/sun_window_term.hpp"
+
 namespace sunvo::rover {
 
 Supervisor::Supervisor(const RoverApp& app, const HealthConfig& config,
@@ -23,12 +25,11 @@ std::optional<int> Supervisor::tick(TimeNs now) {
   const HealthSample sample = app_.healthSample(now);
   const HealthFault fault = watch_.update(sample);
   if (!start_tilt_logged_ && sample.start_tilt_answers > 0) {
-    log_.log(
-        runtime::LogPriority::kInfo,
-        "start tilt: %.3f deg measured from %llu vertical-cue answers %s",
-        static_cast<double>(sample.start_tilt_mdeg) * 1e-3,
-        static_cast<unsigned long long>(sample.start_tilt_answers),
-        sample.start_tilt_removed ? "and removed" : "(within their noise: left to the filter)");
+    log_.log(runtime::LogPriority::kInfo,
+             "start tilt: %.3f deg measured from %llu vertical-cue answers %s",
+             static_cast<double>(sample.start_tilt_mdeg) * 1e-3,
+             static_cast<unsigned long long>(sample.start_tilt_answers),
+             sunfusion::startTiltOutcome(sample.start_tilt_removed));
     start_tilt_logged_ = true;
   }
   if (watch_.clockJumps() != jumps_before) {

@@ -282,10 +282,9 @@ int main(int argc, char** argv) {
                      static_cast<unsigned long long>(g.rejected_innovation));
       }
       if (run->start_tilt_judged) {
-        std::fprintf(
-            stderr, "    start tilt error %.3f deg measured from %d answers %s\n",
-            run->start_tilt_deg, run->world_up_answers,
-            run->start_levelled ? "and removed" : "(within their noise: left to the filter)");
+        std::fprintf(stderr, "    start tilt error %.3f deg measured from %d answers %s\n",
+                     run->start_tilt_deg, run->world_up_answers,
+                     sunvo::sunfusion::startTiltOutcome(run->start_levelled));
       } else if (run->world_up_answers > 0) {
         std::fprintf(stderr, "    world's up from %d answers: %.3f deg from the true one\n",
                      run->world_up_answers, run->world_up_error_deg);

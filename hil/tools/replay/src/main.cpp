@@ -250,10 +250,9 @@ int main(int argc, char** argv) {
                    static_cast<unsigned long long>(run->vertical_stats.errors));
     }
     if (run->start_tilt_judged) {
-      std::fprintf(
-          stderr, "  %-28s start tilt error %.3f deg measured from %d cue answers %s\n", "",
-          run->world_up_tilt_deg, run->world_up_answers,
-          run->start_levelled ? "and removed" : "(within their noise: left to the filter)");
+      std::fprintf(stderr, "  %-28s start tilt error %.3f deg measured from %d cue answers %s\n",
+                   "", run->world_up_tilt_deg, run->world_up_answers,
+                   sunvo::sunfusion::startTiltOutcome(run->start_levelled));
     } else if (run->world_up_answers > 0) {
       std::fprintf(stderr,
                    "  %-28s world's up (%.4f, %.4f, %.4f) from %d cue answers: %.3f deg off the "

@@ -276,6 +276,12 @@ inline constexpr int kStartTiltFrames = 15;
 // innovation gate).
 inline constexpr double kStartTiltChi2 = 9.21;
 
+// How the programs say what became of the start's tilt once judged: "... measured from N answers
+// and removed" or "... (within their noise: left to the filter)".
+inline const char* startTiltOutcome(bool removed) {
+  return removed ? "and removed" : "(within their noise: left to the filter)";
+}
+
 // The fusion's settings for an image sun estimator (Sun-CNN, Lalonde, Lalonde-VO), whose errors
 // stay alike for a street and can be biased for a whole drive; sunvo_replay's image-estimator
 // options and the rover's estimator defaults start from these.
@@ -458,7 +464,9 @@ class SunWindowTerm {
   double persistence_T_ = 0.0;
   std::array<double, 4> persistence_bound_{};  // chi-square quantile by rank 1..3
   std::optional<std::uint64_t> last_sequence_;
-  SunGateOptions start_gate_;   // kStartTilt: vertical_gate with start_tilt_max_deg's bound
+  // The gate an answer must pass to be collected by world_up_: vertical_gate, its cosine bound
+  // widened to start_tilt_max_deg for kStartTilt.
+  SunGateOptions alignment_gate_;
   bool start_decided_ = false;  // kStartTilt: the alignment is done and its tilt was judged
   bool levelled_ = false;       // kStartTilt: the start was levelled (takeStartLevelling)
   AttitudePriorResidual* prior_ = nullptr;  // owned by prior_cost_
