@@ -3,10 +3,7 @@
 // stops the program with SIGTERM, and evaluates accuracy and latency. Compared with the
 // sequential replay (sunvo_replay's chain) on the same frames.
 
-#include <fcntl.h>
 #include <gtest/gtest.h>
-#include <sys/file.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -21,6 +18,7 @@
 #include <thread>
 
 #include "../support/recording_link.hpp"
+#include "../support/render_once.hpp"
 #include "../support/temp_dir.hpp"
 #include "sunvo/metrics/metrics.hpp"
 #include "sunvo/render/drive.hpp"
@@ -56,28 +54,10 @@ std::string findOrRenderDrive(int* frames) {
   if (!scenario) return {};
   scenario->frames = 20;
   *frames = 20;
-  const fs::path out = fs::path(SUNVO_BINARY_DIR) / "test_render_cache" / "rover_20";
-  const fs::path done = out / "complete";
-  // The tests of this file run in parallel under ctest -j: one renders, the others wait for it
-  // (an exclusive lock held until this function returns).
-  fs::create_directories(out.parent_path());
-  const int lock_fd = ::open((out.string() + ".lock").c_str(), O_CREAT | O_RDWR | O_CLOEXEC, 0644);
-  if (lock_fd < 0 || ::flock(lock_fd, LOCK_EX) != 0) return {};
-  struct Unlock {
-    int fd;
-    ~Unlock() { ::close(fd); }  // closing releases the lock
-  } unlock{lock_fd};
-  if (fs::exists(done)) {
-    std::ifstream in(done);
-    std::string drive;
-    std::getline(in, drive);
-    if (fs::exists(fs::path(drive) / "gt" / "poses_cam0_enu.txt")) return drive;
-  }
-  fs::remove_all(out);
-  auto drive = render::renderDrive(*scenario, out.string(), 2, {});
-  if (!drive) return {};
-  std::ofstream(done) << *drive << "\n";
-  return *drive;
+  // The tests of this file run in parallel under ctest -j: one renders, the others wait for it.
+  return sunvo::testing::renderOnce(*scenario,
+                                    fs::path(SUNVO_BINARY_DIR) / "test_render_cache" / "rover_20",
+                                    "gt/poses_cam0_enu.txt");
 }
 
 double jsonNumber(const std::string& json, const std::string& key) {

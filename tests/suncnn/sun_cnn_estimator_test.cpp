@@ -16,6 +16,7 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
+#include "../support/render_once.hpp"
 #include "sunvo/render/drive.hpp"
 
 namespace sunvo::suncnn {
@@ -83,14 +84,14 @@ const HeldOutFrames& heldOutFrames() {
     EXPECT_TRUE(s.hasValue()) << s.status().toString();
     if (!s) return r;
     s->frames = 8;
-    const auto out = std::filesystem::path(SUNVO_BINARY_DIR) / "test_render_cache" / "suncnn_8";
-    // Rendered once per build folder (about 10 s); the drive folder name is fixed by the scenario.
-    Expected<std::string> rendered = (out / "2026_07_14" / "2026_07_14_drive_0314_sync").string();
-    if (!std::filesystem::exists(*rendered + "/image_03/data/0000000007.png"))
-      rendered = render::renderDrive(*s, out.string(), 2, {});
-    EXPECT_TRUE(rendered.hasValue()) << rendered.status().toString();
-    if (!rendered) return r;
-    std::ifstream csv(*rendered + "/gt/sun_cam0.csv");
+    // Rendered once per build folder (about 10 s); the test cases run in parallel processes under
+    // ctest -j, and one reading a drive another is still writing found no frames.
+    const std::string drive = sunvo::testing::renderOnce(
+        *s, std::filesystem::path(SUNVO_BINARY_DIR) / "test_render_cache" / "suncnn_8",
+        "image_03/data/0000000007.png");
+    EXPECT_FALSE(drive.empty()) << "the held-out frames could not be rendered";
+    if (drive.empty()) return r;
+    std::ifstream csv(drive + "/gt/sun_cam0.csv");
     std::string line;
     std::getline(csv, line);
     while (std::getline(csv, line)) {
@@ -100,7 +101,7 @@ const HeldOutFrames& heldOutFrames() {
       char fn[32];
       std::snprintf(fn, sizeof fn, "%010d.png", k);
       for (const char* cam : {"/image_02/data/", "/image_03/data/"}) {
-        r.images.push_back(cv::imread(*rendered + cam + fn, cv::IMREAD_COLOR));
+        r.images.push_back(cv::imread(drive + cam + fn, cv::IMREAD_COLOR));
         r.sun_c.emplace_back(x, y, z);
       }
     }
@@ -210,6 +211,7 @@ double medianErrorDeg(const std::string& model, bool grey_images) {
     err.push_back(std::fabs(std::remainder(e->azimuth_deg - azimuthDeg(f.sun_c[i]), 360.0)));
     sigma.push_back(e->measurement.sigma);
   }
+  if (err.empty()) return 180.0;  // no frames: the size check above has failed already
   std::sort(err.begin(), err.end());
   std::sort(sigma.begin(), sigma.end());
   std::printf(
