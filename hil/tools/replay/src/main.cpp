@@ -89,6 +89,9 @@ int main(int argc, char** argv) {
   sunvo::cli::addEnumOption(app, "--vertical-detector", options.vertical.estimator.detector,
                             "the cue's segment detector (default edge_chains; lsd: OpenCV's, the "
                             "baseline)");
+  app.add_option("--vertical-line-sigma-deg", options.vertical.estimator.line_sigma_deg,
+                 "the cue's error of one segment's plane angle, which sets its reported sigma, deg")
+      ->check(CLI::Range(0.001, 10.0));
   app.add_option("--world-up-alignment-frames", options.world_up_alignment_frames,
                  "the cue's answers of the first N frames measure the world's up (-1: 50 when the "
                  "world is the first camera, which nobody levelled; 0 in ENU)")
