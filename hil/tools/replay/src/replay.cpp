@@ -1,5 +1,6 @@
 #include "sunvo/replay/replay.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "sunvo/kitti/stereo_source.hpp"
@@ -87,6 +88,11 @@ Expected<ReplayRun> replayDrive(const dataset::Dataset& data, const ReplayOption
   pipeline::SunAidedOptions sao;
   sao.pipeline = options.pipeline;
   sao.pipeline.vo.window.max_solver_time_in_seconds = 60.0;  // replay: bounded by iterations only
+  // The front end's buffers are allocated for the largest image it accepts: at least the drive's
+  // own (another rig's 1280x720 was refused), as the rover sizes them from its cameras.
+  sao.pipeline.frontend.max_width = std::max(sao.pipeline.frontend.max_width, data.camera().width);
+  sao.pipeline.frontend.max_height =
+      std::max(sao.pipeline.frontend.max_height, data.camera().height);
   sao.use_sun = sun;
   sao.every_n_frames = options.every_n_frames;
   sao.vertical = options.vertical;
