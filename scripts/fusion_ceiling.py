@@ -27,19 +27,11 @@ import argparse
 import math
 import random
 
+# The pose files' reader and the small rotation helpers are pose_error_split.py's (this folder).
+from pose_error_split import dot, load, log_so3, transpose
+from pose_error_split import mul as mat_mul
+
 DEG = math.pi / 180.0
-
-
-def load(path):
-    poses = []
-    with open(path) as f:
-        for number, line in enumerate(f, 1):
-            v = line.split()
-            if len(v) != 12:
-                raise SystemExit(f"{path}:{number}: expected 12 numbers, got {len(v)}")
-            v = [float(x) for x in v]
-            poses.append(([v[0:3], v[4:7], v[8:11]], [v[3], v[7], v[11]]))
-    return poses
 
 
 # 3-vectors and 3x3 matrices as lists
@@ -55,10 +47,6 @@ def scale(a, s):
     return [x * s for x in a]
 
 
-def dot(a, b):
-    return sum(x * y for x, y in zip(a, b))
-
-
 def cross(a, b):
     return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 
@@ -71,14 +59,6 @@ def mat_vec(m, v):
     return [dot(row, v) for row in m]
 
 
-def mat_mul(a, b):
-    return [[sum(a[i][k] * b[k][j] for k in range(3)) for j in range(3)] for i in range(3)]
-
-
-def transpose(a):
-    return [[a[j][i] for j in range(3)] for i in range(3)]
-
-
 def exp_so3(w):
     th = norm(w)
     if th < 1e-12:
@@ -89,16 +69,6 @@ def exp_so3(w):
     kk = mat_mul(kx, kx)
     return [[(1.0 if i == j else 0.0) + s * kx[i][j] + c * kk[i][j] for j in range(3)]
             for i in range(3)]
-
-
-def log_so3(r):
-    c = max(-1.0, min(1.0, (r[0][0] + r[1][1] + r[2][2] - 1.0) / 2.0))
-    th = math.acos(c)
-    if th < 1e-12:
-        return [0.0, 0.0, 0.0]
-    s = 2.0 * math.sin(th)
-    return [(r[2][1] - r[1][2]) / s * th, (r[0][2] - r[2][0]) / s * th,
-            (r[1][0] - r[0][1]) / s * th]
 
 
 class Route:

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <optional>
 
 #include "sunvo/core/geometry.hpp"
 #include "sunvo/metrics/metrics.hpp"
@@ -15,17 +16,25 @@
 namespace sunvo::replay {
 namespace {
 
+// The CI drive's first `frames` frames, rendered afresh into test_render_cache/<folder>, through
+// `camera` when given (another rig). Returns the drive's folder.
+Expected<std::string> renderCiDrive(int frames, const std::string& folder,
+                                    const std::optional<StereoCamera>& camera = std::nullopt) {
+  auto scenario =
+      render::loadScenario(std::string(SUNVO_SOURCE_DIR) + "/config/scenarios/ci_short.yaml");
+  if (!scenario) return scenario.status();
+  scenario->frames = frames;
+  if (camera) scenario->camera = *camera;
+  const auto out = std::filesystem::path(SUNVO_BINARY_DIR) / "test_render_cache" / folder;
+  std::filesystem::remove_all(out);
+  return render::renderDrive(*scenario, out.string(), 2, {});
+}
+
 // Renders the first 20 frames of the CI drive with POV-Ray, then replays them through the whole
 // chain (KITTI raw source, OXTS, ENU world, SPA, image VO, sun fusion) and checks the accuracy
 // against the renderer's ground truth. This is the regression test of the replay path.
 TEST(Replay, RenderedDriveThroughTheWholeChain) {
-  auto scenario =
-      render::loadScenario(std::string(SUNVO_SOURCE_DIR) + "/config/scenarios/ci_short.yaml");
-  ASSERT_TRUE(scenario) << scenario.status().toString();
-  scenario->frames = 20;
-  const auto out = std::filesystem::path(SUNVO_BINARY_DIR) / "test_render_cache" / "replay_20";
-  std::filesystem::remove_all(out);
-  auto drive = render::renderDrive(*scenario, out.string(), 2, {});
+  auto drive = renderCiDrive(20, "replay_20");
   ASSERT_TRUE(drive) << drive.status().toString();
 
   ReplayOptions options;
@@ -223,14 +232,8 @@ TEST(Replay, RenderedDriveThroughTheWholeChain) {
 // default buffers take) load and replay; the front end is sized from the drive, as the rover
 // sizes it from its cameras (a 1280x720 drive was refused before).
 TEST(Replay, ADriveOfAnotherRigSizesTheFrontEnd) {
-  auto scenario =
-      render::loadScenario(std::string(SUNVO_SOURCE_DIR) + "/config/scenarios/ci_short.yaml");
-  ASSERT_TRUE(scenario) << scenario.status().toString();
-  scenario->frames = 6;
-  scenario->camera = StereoCamera{500.0, 500.0, 322.0, 236.0, 0.25, 640, 480};
-  const auto out = std::filesystem::path(SUNVO_BINARY_DIR) / "test_render_cache" / "replay_640x480";
-  std::filesystem::remove_all(out);
-  auto drive = render::renderDrive(*scenario, out.string(), 2, {});
+  auto drive =
+      renderCiDrive(6, "replay_640x480", StereoCamera{500.0, 500.0, 322.0, 236.0, 0.25, 640, 480});
   ASSERT_TRUE(drive) << drive.status().toString();
 
   ReplayOptions options;
