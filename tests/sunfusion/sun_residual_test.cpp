@@ -140,5 +140,49 @@ TEST(SunResiduals, AutodiffMatchesCentralDifferences) {
   }
 }
 
+// The square-root information of a direction measured better along one axis: W^T W is the inverse
+// of R_s = sigma^2 (I - a a^T) + sigma_s^2 a a^T for an axis a normal to the measurement, the axis
+// is first made normal to it, and an unusable axis or sigma_strong falls back to I / sigma.
+TEST(DirectionSqrtInformationTest, WhitensTheStrongAxisByItsOwnSigma) {
+  const Eigen::Vector3d s = Eigen::Vector3d(0.1, -0.99, 0.05).normalized();
+  const Eigen::Vector3d a = s.cross(Eigen::Vector3d::UnitZ()).normalized();
+  const double sigma = 0.02, sigma_s = 0.004;
+  const Eigen::Matrix3d R = sigma * sigma * (Eigen::Matrix3d::Identity() - a * a.transpose()) +
+                            sigma_s * sigma_s * a * a.transpose();
+  const Eigen::Matrix3d W = directionSqrtInformation(s, sigma, sigma_s, a);
+  EXPECT_LT((W.transpose() * W - R.inverse()).norm() / R.inverse().norm(), 1e-12);
+  // An axis with a part along s is projected: the same W.
+  const Eigen::Matrix3d W2 = directionSqrtInformation(s, sigma, sigma_s, 3.0 * a + 0.5 * s);
+  EXPECT_LT((W2 - W).norm(), 1e-9 * W.norm());
+  const Eigen::Matrix3d iso = Eigen::Matrix3d::Identity() / sigma;
+  EXPECT_EQ(directionSqrtInformation(s, sigma, 0.0, a), iso);
+  EXPECT_EQ(directionSqrtInformation(s, sigma, sigma, a), iso);  // not smaller
+  EXPECT_EQ(directionSqrtInformation(s, sigma, 2.0 * sigma, a), iso);
+  EXPECT_EQ(directionSqrtInformation(s, sigma, sigma_s, Eigen::Vector3d::Zero()), iso);
+  EXPECT_EQ(directionSqrtInformation(s, sigma, sigma_s, s), iso);  // along the measurement
+  EXPECT_EQ(directionSqrtInformation(s, sigma, sigma_s, Eigen::Vector3d(NAN, 0.0, 1.0)), iso);
+  EXPECT_EQ(directionSqrtInformation(s, sigma, NAN, a), iso);
+}
+
+// The residual applies it: an error along the strong axis is weighed by 1 / sigma_strong, one
+// across it by 1 / sigma.
+TEST(SunDirectionResidualTest, StrongAxisWeighsItsErrorByItsOwnSigma) {
+  const Eigen::Vector3d measured(0.0, -1.0, 0.0);
+  const double eps = 1e-4;
+  const auto whitenedNorm = [&](const Eigen::Vector3d& truth_b, double sigma_strong) {
+    SunDirectionResidual r(truth_b, measured, 0.02);
+    r.set(truth_b, measured, 0.02, 0.0, sigma_strong, Eigen::Vector3d::UnitX());
+    const double q[4] = {0.0, 0.0, 0.0, 1.0};  // identity, Eigen order x, y, z, w
+    double e[3];
+    EXPECT_TRUE(r(q, e));
+    return std::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+  };
+  const Eigen::Vector3d along_x = Eigen::Vector3d(eps, -1.0, 0.0).normalized();
+  const Eigen::Vector3d along_z = Eigen::Vector3d(0.0, -1.0, eps).normalized();
+  EXPECT_NEAR(whitenedNorm(along_x, 0.004), eps / 0.004, 1e-3 * eps / 0.004);
+  EXPECT_NEAR(whitenedNorm(along_z, 0.004), eps / 0.02, 1e-3 * eps / 0.02);
+  EXPECT_NEAR(whitenedNorm(along_x, 0.0), eps / 0.02, 1e-3 * eps / 0.02);
+}
+
 }  // namespace
 }  // namespace sunvo::sunfusion

@@ -96,6 +96,39 @@ TEST_F(VerticalEstimatorTest, PolesInOneColumnGiveALargerSigma) {
   EXPECT_GT(bunched->sigma_rad, 3.0 * spread->sigma_rad);
 }
 
+TEST_F(VerticalEstimatorTest, PolesInOneColumnFixTheRollButNotThePitch) {
+  // Bunched poles keep their image angles, which is the roll of a level camera (a turn about the
+  // optical axis moves "up" along the camera's x axis): the better direction is that axis, and
+  // its sigma stays small while the pitch's grows. With per_axis_sigma off both are the worse one.
+  const Eigen::Matrix3d C_c_w = expSO3(Eigen::Vector3d(-1.0 * kDeg, 0.0, 1.0 * kDeg));
+  const cv::Mat img = street(C_c_w, -2.0, 2.0, 30);
+  VerticalOptions options;
+  options.min_sigma_deg = 0.001;  // the raw sigmas, not the floor
+  VerticalEstimator est;
+  ASSERT_TRUE(est.init(options, kittiCamera()).isOk());
+  auto m = est.estimate(img, Eigen::Vector3d(0.0, -1.0, 0.0));
+  ASSERT_TRUE(m) << m.status().toString();
+  ASSERT_GE(m->inliers, 8);
+  EXPECT_NEAR(m->strong_axis_c.norm(), 1.0, 1e-9);
+  EXPECT_NEAR(m->strong_axis_c.dot(m->up_c), 0.0, 1e-9);
+  EXPECT_GT(std::abs(m->strong_axis_c.x()), 0.99);
+  EXPECT_LT(m->sigma_strong_rad * 5.0, m->sigma_rad);
+  options.per_axis_sigma = false;
+  ASSERT_TRUE(est.init(options, kittiCamera()).isOk());
+  auto iso = est.estimate(img, Eigen::Vector3d(0.0, -1.0, 0.0));
+  ASSERT_TRUE(iso);
+  EXPECT_EQ(iso->sigma_strong_rad, iso->sigma_rad);
+  EXPECT_EQ(iso->sigma_rad, m->sigma_rad);
+  // The floor holds for both directions.
+  options.per_axis_sigma = true;
+  options.min_sigma_deg = 0.2;
+  ASSERT_TRUE(est.init(options, kittiCamera()).isOk());
+  auto floored = est.estimate(img, Eigen::Vector3d(0.0, -1.0, 0.0));
+  ASSERT_TRUE(floored);
+  EXPECT_GE(floored->sigma_strong_rad, 0.2 * kDeg);
+  EXPECT_LE(floored->sigma_strong_rad, floored->sigma_rad);
+}
+
 TEST_F(VerticalEstimatorTest, NoVerticalEdgesIsAnInvalidMeasurementNotAnError) {
   VerticalEstimator est;
   ASSERT_TRUE(est.init(VerticalOptions{}, kittiCamera()).isOk());

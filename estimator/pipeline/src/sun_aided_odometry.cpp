@@ -93,6 +93,8 @@ Expected<FrameResult> SunAidedOdometry::process(const StereoFrame& frame) {
       o.measurement.kind = sunfusion::SunMeasurementKind::kFull3d;
       o.measurement.sun_c = m->up_c;
       o.measurement.sigma = m->sigma_rad;
+      o.measurement.sigma_strong = m->sigma_strong_rad;
+      o.measurement.strong_axis_c = m->strong_axis_c;
       o.sun_w = up_w;
       sun_term_.addVertical(o);
     }

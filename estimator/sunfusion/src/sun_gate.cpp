@@ -75,7 +75,8 @@ GateResult gateSunMeasurement(const SunGateOptions& options, const Eigen::Vector
   if (std::asin(std::clamp(sun_up, -1.0, 1.0)) * 180.0 / M_PI < options.min_sun_elevation_deg) {
     return GateResult::kRejectedSunDown;
   }
-  if (!m.sun_c.allFinite() || !(m.sigma > 0.0) || !std::isfinite(m.sigma)) {
+  if (!m.sun_c.allFinite() || !(m.sigma > 0.0) || !std::isfinite(m.sigma) ||
+      !std::isfinite(m.sigma_strong) || m.sigma_strong < 0.0 || !m.strong_axis_c.allFinite()) {
     return GateResult::kRejectedInvalid;
   }
   const bool azimuth_only = m.kind == SunMeasurementKind::kAzimuthOnly;

@@ -113,7 +113,7 @@ ceres::CostFunction* SunWindowTerm::setSunCost(std::size_t ring, const Eigen::Ve
     c.azimuth->set(sun_b, xzDirection(m.sun_c), m.sigma, bias_);
     return c.azimuth_cost.get();
   }
-  c.direction->set(sun_b, m.sun_c, m.sigma, bias_);
+  c.direction->set(sun_b, m.sun_c, m.sigma, bias_, m.sigma_strong, m.strong_axis_c);
   return c.direction_cost.get();
 }
 

@@ -68,8 +68,8 @@ Status VerticalEstimator::init(const VerticalOptions& options, const StereoCamer
   return Status::ok();
 }
 
-bool VerticalEstimator::refine(double bound, Eigen::Vector3d* up, int* inliers,
-                               double* sigma) const {
+bool VerticalEstimator::refine(double bound, Eigen::Vector3d* up, int* inliers, double* sigma,
+                               double* sigma_strong, Eigen::Vector3d* strong_axis) const {
   Eigen::Matrix3d M = Eigen::Matrix3d::Zero();   // length-weighted: the estimate
   Eigen::Matrix3d M1 = Eigen::Matrix3d::Zero();  // one per segment: its information
   int count = 0;
@@ -86,16 +86,22 @@ bool VerticalEstimator::refine(double bound, Eigen::Vector3d* up, int* inliers,
   if (u.dot(*up) < 0.0) u = -u;
   u.normalize();
   // Information about u in its tangent plane, each segment's plane angle with std line_sigma:
-  // the smaller eigenvalue of P M1 P (P projects onto the plane normal to u).
+  // the eigenvalues of P M1 P (P projects onto the plane normal to u): (0) is ~0, along u; (1)
+  // the weakest tangent direction, (2) the strongest.
   const Eigen::Matrix3d P = Eigen::Matrix3d::Identity() - u * u.transpose();
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> tangent(P * M1 * P);
-  const double weakest = tangent.eigenvalues()(1);  // (0) is ~0, along u
   const double line_sigma = options_.line_sigma_deg * kDeg;
-  const double worst = line_sigma * line_sigma / std::max(weakest, 1e-300);
-  if (!u.allFinite() || !std::isfinite(worst)) return false;
+  const double worst = line_sigma * line_sigma / std::max(tangent.eigenvalues()(1), 1e-300);
+  const double best = line_sigma * line_sigma / std::max(tangent.eigenvalues()(2), 1e-300);
+  const Eigen::Vector3d axis = tangent.eigenvectors().col(2);
+  if (!u.allFinite() || !std::isfinite(worst) || !std::isfinite(best) || !axis.allFinite()) {
+    return false;
+  }
   *up = u;
   *inliers = count;
   *sigma = std::sqrt(worst);
+  *sigma_strong = std::sqrt(best);
+  *strong_axis = axis.normalized();
   return true;
 }
 
@@ -192,10 +198,11 @@ Expected<VerticalMeasurement> VerticalEstimator::estimate(const cv::Mat& gray,
     out.reason = "no vanishing point within max_tilt_deg of the prior";
     return out;
   }
-  double sigma = 0.0;
+  double sigma = 0.0, sigma_strong = 0.0;
+  Eigen::Vector3d strong_axis = Eigen::Vector3d::UnitX();
   int inliers = 0;
   for (int pass = 0; pass < 3; ++pass) {
-    if (!refine(inlier_bound, &best, &inliers, &sigma)) {
+    if (!refine(inlier_bound, &best, &inliers, &sigma, &sigma_strong, &strong_axis)) {
       out.reason = "too few inliers to refine";
       return out;
     }
@@ -203,6 +210,10 @@ Expected<VerticalMeasurement> VerticalEstimator::estimate(const cv::Mat& gray,
   out.up_c = best;
   out.inliers = inliers;
   out.sigma_rad = std::max(sigma, options_.min_sigma_deg * kDeg);
+  out.sigma_strong_rad = options_.per_axis_sigma
+                             ? std::max(sigma_strong, options_.min_sigma_deg * kDeg)
+                             : out.sigma_rad;
+  out.strong_axis_c = strong_axis;
   if (inliers < options_.min_inliers) {
     out.reason = "too few inliers";
   } else if (out.sigma_rad > options_.max_sigma_deg * kDeg) {

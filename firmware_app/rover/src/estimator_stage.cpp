@@ -37,6 +37,9 @@ void EstimatorStage::takeSunResults(std::uint64_t waiting_for, bool* got) {
       up.measurement.kind = sunfusion::SunMeasurementKind::kFull3d;
       up.measurement.sun_c = Eigen::Vector3d(r.up_c[0], r.up_c[1], r.up_c[2]);
       up.measurement.sigma = r.up_sigma;
+      up.measurement.sigma_strong = r.up_sigma_strong;
+      up.measurement.strong_axis_c =
+          Eigen::Vector3d(r.up_strong_axis_c[0], r.up_strong_axis_c[1], r.up_strong_axis_c[2]);
       up.sun_w = Eigen::Vector3d::UnitZ();  // ENU
       odometry_.addVertical(up);
     }

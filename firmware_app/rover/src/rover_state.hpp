@@ -42,10 +42,13 @@ struct SunResult {
   double sun_c[3] = {0, 0, 1};
   double sigma = 0.1;
   double sun_w[3] = {0, 0, 1};
-  // The vertical cue (estimator.vertical.enabled): "up" in the camera and its sigma, rad.
+  // The vertical cue (estimator.vertical.enabled): "up" in the camera and its sigma, rad (the
+  // worse tangent direction's; up_sigma_strong along up_strong_axis_c, the better one's).
   bool has_up = false;
   double up_c[3] = {0, -1, 0};
   double up_sigma = 0.01;
+  double up_sigma_strong = 0.0;
+  double up_strong_axis_c[3] = {0, 0, 0};
 };
 
 // Counters of everything that can go wrong or be late, written by the stages, read by summary().

@@ -56,8 +56,12 @@ void SunStage::measureUp(const SunQuery& query, SunResult& res) {
   if (!m->valid || !m->up_c.allFinite() || !std::isfinite(m->sigma_rad)) return;
   health.vertical_valid.fetch_add(1, std::memory_order_relaxed);
   res.has_up = true;
-  for (int i = 0; i < 3; ++i) res.up_c[i] = m->up_c[i];
+  for (int i = 0; i < 3; ++i) {
+    res.up_c[i] = m->up_c[i];
+    res.up_strong_axis_c[i] = m->strong_axis_c[i];
+  }
   res.up_sigma = m->sigma_rad;
+  res.up_sigma_strong = m->sigma_strong_rad;
 }
 
 void SunStage::run() {

@@ -92,6 +92,10 @@ int main(int argc, char** argv) {
   app.add_option("--vertical-line-sigma-deg", options.vertical.estimator.line_sigma_deg,
                  "the cue's error of one segment's plane angle, which sets its reported sigma, deg")
       ->check(CLI::Range(0.001, 10.0));
+  bool isotropic_vertical = false;
+  app.add_flag("--vertical-isotropic", isotropic_vertical,
+               "the cue reports its worse direction's sigma for both (per_axis_sigma off, as "
+               "before 2026-11-28)");
   app.add_option("--world-up-alignment-frames", options.world_up_alignment_frames,
                  "the cue's answers of the first N frames measure the world's up (-1: 50 when the "
                  "world is the first camera, which nobody levelled; 0 in ENU)")
@@ -126,6 +130,7 @@ int main(int argc, char** argv) {
       "also write each run's poses, OUT/replay_poses_<run>.txt (KITTI) and _tum.txt (TUM)");
   if (auto code = sunvo::cli::parse(app, argc, argv)) return *code;
   options.fusion.estimate_base_attitude = !paper_form;
+  if (isotropic_vertical) options.vertical.estimator.per_axis_sigma = false;
   if (level_start) {
     options.fusion.world_up_alignment_use = sunvo::sunfusion::WorldUpAlignmentUse::kStartTilt;
   }

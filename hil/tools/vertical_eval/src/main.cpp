@@ -74,12 +74,12 @@ int main(int argc, char** argv) {
     csv.open(csv_path);
     if (!csv) return sunvo::cli::fail(kProgram, "cannot write '" + csv_path + "'");
     csv << "set,frame,valid,reason,candidates,inliers,error_deg,roll_deg,pitch_deg,sigma_deg,"
-           "level_deg,cpu_ms\n";
+           "level_deg,cpu_ms,sigma_strong_deg,error_strong_deg,error_weak_deg\n";
   }
   std::printf(
       "| set | frames | valid | median error [deg] | p90 [deg] | roll / pitch median [deg] | "
-      "< 2 sigma | level prior median [deg] | CPU ms median "
-      "|\n|---|---|---|---|---|---|---|---|---|\n");
+      "< 2 sigma | better / worse axis: sigma median [deg], |error| < 2 sigma | level prior median "
+      "[deg] | CPU ms median |\n|---|---|---|---|---|---|---|---|---|---|\n");
   const Eigen::Vector3d level(0.0, -1.0, 0.0);
   for (const std::string& dir : sets) {
     se::EvalSetOptions eo;
@@ -91,8 +91,8 @@ int main(int argc, char** argv) {
     if (auto s = estimator.init(options, ds->camera); !s.isOk()) {
       return sunvo::cli::fail(kProgram, dir + ": " + s.toString());
     }
-    std::vector<double> err, roll, pitch, lev, ms;
-    int n = 0, within = 0;
+    std::vector<double> err, roll, pitch, lev, ms, sig_strong, sig_weak;
+    int n = 0, within = 0, within_strong = 0, within_weak = 0;
     for (std::size_t k = 0; k < ds->frames.size(); k += static_cast<std::size_t>(every)) {
       const se::EvalFrame& f = ds->frames[k];
       const cv::Mat gray = cv::imread(f.image_path, cv::IMREAD_GRAYSCALE);
@@ -108,7 +108,15 @@ int main(int argc, char** argv) {
       // Small rotation taking the truth to the estimate, camera axes: z = roll, x = pitch.
       const Eigen::Vector3d e = truth.cross(m->up_c);
       const double a = angleDeg(m->up_c, truth);
+      // The error along the estimate's better tangent axis and along the worse one (rad).
+      const Eigen::Vector3d d = m->up_c - truth;
+      const Eigen::Vector3d weak_axis = m->up_c.cross(m->strong_axis_c).normalized();
+      const double e_strong = d.dot(m->strong_axis_c), e_weak = d.dot(weak_axis);
       if (m->valid) {
+        sig_strong.push_back(m->sigma_strong_rad / kDeg);
+        sig_weak.push_back(m->sigma_rad / kDeg);
+        if (std::abs(e_strong) < 2.0 * m->sigma_strong_rad) ++within_strong;
+        if (std::abs(e_weak) < 2.0 * m->sigma_rad) ++within_weak;
         err.push_back(a);
         roll.push_back(e.z() / kDeg);
         pitch.push_back(e.x() / kDeg);
@@ -117,7 +125,8 @@ int main(int argc, char** argv) {
       if (csv.is_open()) {
         csv << ds->name << ',' << k << ',' << (m->valid ? 1 : 0) << ',' << m->reason << ','
             << m->candidates << ',' << m->inliers << ',' << a << ',' << e.z() / kDeg << ','
-            << e.x() / kDeg << ',' << m->sigma_rad / kDeg << ',' << lev.back() << ',' << dt << '\n';
+            << e.x() / kDeg << ',' << m->sigma_rad / kDeg << ',' << lev.back() << ',' << dt << ','
+            << m->sigma_strong_rad / kDeg << ',' << e_strong / kDeg << ',' << e_weak / kDeg << '\n';
       }
     }
     // A render or raw drive is <set>/<date>/<date>_drive_NNNN_sync: name it by <set>.
@@ -128,12 +137,17 @@ int main(int argc, char** argv) {
       if (!set.empty() && set != ".") name = set + "/" + name;
     }
     const double valid_share = n > 0 ? static_cast<double>(err.size()) / n : 0.0;
-    const double within_share = err.empty() ? se::kNaN : static_cast<double>(within) / err.size();
-    std::printf("| %s%s | %d | %.0f %% | %.2f | %.2f | %+.2f / %+.2f | %.0f %% | %.2f | %.1f |\n",
-                name.c_str(), ds->level_assumed ? " (up: level rig assumed)" : "", n,
-                100.0 * valid_share, se::quantile(err, 0.5), se::quantile(err, 0.9),
-                se::quantile(roll, 0.5), se::quantile(pitch, 0.5), 100.0 * within_share,
-                se::quantile(lev, 0.5), se::quantile(ms, 0.5));
+    const auto share = [&](int k) {
+      return err.empty() ? se::kNaN : 100.0 * static_cast<double>(k) / err.size();
+    };
+    std::printf(
+        "| %s%s | %d | %.0f %% | %.2f | %.2f | %+.2f / %+.2f | %.0f %% | %.2f, %.0f %% / %.2f, "
+        "%.0f %% | %.2f | %.1f |\n",
+        name.c_str(), ds->level_assumed ? " (up: level rig assumed)" : "", n, 100.0 * valid_share,
+        se::quantile(err, 0.5), se::quantile(err, 0.9), se::quantile(roll, 0.5),
+        se::quantile(pitch, 0.5), share(within), se::quantile(sig_strong, 0.5),
+        share(within_strong), se::quantile(sig_weak, 0.5), share(within_weak),
+        se::quantile(lev, 0.5), se::quantile(ms, 0.5));
   }
   return 0;
 }

@@ -14,6 +14,8 @@
 #include <Eigen/Geometry>
 #include <cmath>
 
+#include "sunvo/sunfusion/sun_measurement.hpp"
+
 namespace sunvo::sunfusion {
 
 // The sun predicted in camera k.
@@ -74,7 +76,10 @@ ceres::CostFunction* wrapSunResidual(Residual* r, SunResidualForm form) {
 // Full 3-D sun residual (the paper's Eq. 3 term).
 //
 //   residual   e_s = s_hat_k - s_k                                 (3-vector, Euclidean)
-//   cost       e_s^T R_s^-1 e_s with R_s = sigma^2 I, so the weighted residual is e_s / sigma.
+//   cost       e_s^T R_s^-1 e_s with R_s = sigma^2 I, so the weighted residual is e_s / sigma;
+//              for a measurement with a strong axis a (sun_measurement.hpp), R_s = sigma^2
+//              (I - a a^T) + sigma_s^2 a a^T and the weighted residual W e_s with
+//              W = I / sigma + (1 / sigma_s - 1 / sigma) a a^T (W^T W = R_s^-1, a normal to s_k).
 //
 // The paper found the Euclidean difference of unit vectors converged better in Ceres than the
 // cosine distance, whose error distribution is far from Gaussian. Both vectors are unit length,
@@ -85,12 +90,14 @@ class SunDirectionResidual {
                        double sigma, double b_hat = 0.0) {
     set(sun_b, sun_k_measured, sigma, b_hat);
   }
-  // New numbers for the same residual (b_hat: the bias estimate, used in the bias form only).
+  // New numbers for the same residual (b_hat: the bias estimate, used in the bias form only;
+  // sigma_strong and strong_axis: a better-measured direction, sun_measurement.hpp).
   void set(const Eigen::Vector3d& sun_b, const Eigen::Vector3d& sun_k_measured, double sigma,
-           double b_hat = 0.0) {
+           double b_hat = 0.0, double sigma_strong = 0.0,
+           const Eigen::Vector3d& strong_axis = Eigen::Vector3d::Zero()) {
     sun_b_ = sun_b;
     sun_k_ = sun_k_measured;
-    inv_sigma_ = 1.0 / sigma;
+    W_ = directionSqrtInformation(sun_k_measured, sigma, sigma_strong, strong_axis);
     b_hat_ = b_hat;
   }
 
@@ -127,13 +134,15 @@ class SunDirectionResidual {
   bool evaluate(const T* q_k_b, const T* delta, const T* bias, T* residual) const {
     Eigen::Matrix<T, 3, 1> s_hat = predictSun(q_k_b, delta, sun_b_);
     if (bias != nullptr) s_hat = turnAboutCameraY(s_hat, T(b_hat_) + bias[0]);
-    for (int i = 0; i < 3; ++i) residual[i] = (s_hat[i] - T(sun_k_[i])) * T(inv_sigma_);
+    const Eigen::Matrix<T, 3, 1> e = s_hat - sun_k_.cast<T>();
+    Eigen::Map<Eigen::Matrix<T, 3, 1>> r(residual);
+    r = W_.cast<T>() * e;
     return true;
   }
 
   Eigen::Vector3d sun_b_;
   Eigen::Vector3d sun_k_;
-  double inv_sigma_ = 1.0;
+  Eigen::Matrix3d W_ = Eigen::Matrix3d::Identity();  // square-root information
   double b_hat_ = 0.0;
 };
 

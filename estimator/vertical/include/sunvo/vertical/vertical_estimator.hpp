@@ -8,10 +8,13 @@
 // and since the plane contains the line, n . up_c = 0. For many vertical segments up_c is the
 // direction least out of all their planes: with weights w_i (segment length, px),
 //   up_c = argmin_|u|=1  sum_i w_i (n_i . u)^2,
-// the eigenvector of M = sum_i w_i n_i n_i^T with the smallest eigenvalue. Its residual
-// s^2 = u^T M u / (sum_i w_i - 2) (rad^2 per unit weight) and the other two eigenvalues l_1, l_2
-// of M give the covariance of u in its tangent plane, s^2 / l_j along eigenvector j; the reported
-// sigma is the larger of the two, floored at min_sigma_deg (real scenes lean a little).
+// the eigenvector of M = sum_i w_i n_i n_i^T with the smallest eigenvalue. With each segment's
+// plane angle off by line_sigma_deg (independent), the covariance of u in its tangent plane is
+// line_sigma^2 (P M1 P)^+, M1 = sum_i n_i n_i^T, P = I - u u^T: along the eigenvector of P M1 P
+// with eigenvalue l_j it is line_sigma^2 / l_j. Both tangent directions are reported (the worse
+// one's sigma, and the better one's with its axis), each floored at min_sigma_deg (real scenes
+// lean a little): the segments' image angles fix the roll of a level camera several times better
+// than their convergence fixes the pitch.
 //
 // Which segments are vertical is found by RANSAC: candidates are the segments whose plane is
 // within max_tilt_deg of the prior up (the current attitude, or level); two candidates give
@@ -61,6 +64,10 @@ struct VerticalOptions {
   double max_sigma_deg = 3.0;   // deg, (0, 90]: a larger sigma = invalid
   double min_sigma_deg = 0.2;   // deg, (0, 10]: floor of the reported sigma
   double line_sigma_deg = 1.0;  // deg, (0, 10]: error of one segment's plane angle
+  // Report the up's uncertainty per tangent direction (sigma_rad along the worse one,
+  // sigma_strong_rad along the better one, each floored at min_sigma_deg); false = the worse
+  // direction's sigma for both (isotropic, as before 2026-11-28).
+  bool per_axis_sigma = true;
   int ransac_iterations = 300;  // [1, 100000]
   std::uint32_t seed = 1;       // RANSAC's sampler, reset per call: same image, same answer
   int max_width_px = 640;       // px, [64, 100000]: wider images are downscaled to it first
@@ -78,6 +85,7 @@ struct VerticalOptions {
     v("max_sigma_deg", s.max_sigma_deg);
     v("min_sigma_deg", s.min_sigma_deg);
     v("line_sigma_deg", s.line_sigma_deg);
+    v("per_axis_sigma", s.per_axis_sigma);
     v("ransac_iterations", s.ransac_iterations);
     v("seed", s.seed);
     v("max_width_px", s.max_width_px);
@@ -90,7 +98,12 @@ struct VerticalOptions {
 struct VerticalMeasurement {
   bool valid = false;
   Eigen::Vector3d up_c = Eigen::Vector3d(0.0, -1.0, 0.0);  // unit, camera frame (x right, y down)
-  double sigma_rad = 0.0;   // 1-sigma angle of up_c (its worse tangent direction)
+  double sigma_rad = 0.0;  // 1-sigma angle of up_c along its worse tangent direction
+  // 1-sigma angle along the better tangent direction strong_axis_c (unit, normal to up_c): for a
+  // level camera the roll, which the segments' image angles give directly, while the pitch
+  // (how the segments converge) is the worse one. Equal to sigma_rad with per_axis_sigma off.
+  double sigma_strong_rad = 0.0;
+  Eigen::Vector3d strong_axis_c = Eigen::Vector3d(1.0, 0.0, 0.0);
   int candidates = 0;       // segments near the prior's vertical
   int inliers = 0;          // segments of the winning vanishing point
   const char* reason = "";  // why invalid ("" when valid)
@@ -111,7 +124,10 @@ class VerticalEstimator {
   };
   // up = the smallest eigenvector of the weighted scatter of the planes with |n . up| < bound;
   // returns false when fewer than 3 planes qualify.
-  bool refine(double bound, Eigen::Vector3d* up, int* inliers, double* sigma) const;
+  // sigma: the worse tangent direction's 1-sigma angle; sigma_strong and strong_axis: the better
+  // one's, and its direction.
+  bool refine(double bound, Eigen::Vector3d* up, int* inliers, double* sigma, double* sigma_strong,
+              Eigen::Vector3d* strong_axis) const;
 
   VerticalOptions options_;
   StereoCamera camera_;
