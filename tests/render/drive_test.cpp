@@ -205,5 +205,62 @@ TEST(Drive, GridHeadingIsRangeChecked) {
       << s.status().toString();
 }
 
+// A render stopped part-way is continued: the frames whose four images exist are kept, the rest
+// is rendered, and the images equal those of the render made in one go. A folder rendered from
+// another scenario is not resumed (the manifest names it); a fresh render leaves no image of an
+// earlier one behind.
+TEST(Drive, AResumedRenderKeepsTheFramesDoneAndRendersTheRest) {
+  auto s = parseScenario(scenarioYaml(0.0), "resume");
+  ASSERT_TRUE(s) << s.status().toString();
+  s->frames = 3;
+  const auto out = std::filesystem::path(SUNVO_BINARY_DIR) / "test_render_cache" / "resume";
+  std::filesystem::remove_all(out);
+  auto drive = renderDrive(*s, out.string(), 2, {});
+  ASSERT_TRUE(drive) << drive.status().toString();
+  const auto image = [&](int c, int k) {
+    char b[64];
+    std::snprintf(b, sizeof b, "/image_0%d/data/%010d.png", c, k);
+    return *drive + b;
+  };
+  std::vector<std::string> first;
+  for (int k = 0; k < 3; ++k)
+    for (int c = 0; c < 4; ++c) first.push_back(readText(image(c, k)));
+  for (const std::string& bytes : first) ASSERT_GT(bytes.size(), 100u);
+
+  // Frame 1 lost one image (a run killed between its renders); frame 2's scene changed.
+  std::filesystem::remove(image(2, 1));
+  {
+    std::ofstream pov(*drive + "/pov/frame_000002.pov", std::ios::app);
+    pov << "// edited\n";
+  }
+  DriveProgress last;
+  auto again = renderDrive(
+      *s, out.string(), 2, [&](const DriveProgress& p) { last = p; }, true);
+  ASSERT_TRUE(again) << again.status().toString();
+  EXPECT_EQ(last.kept_frames, 1u);  // frame 0
+  EXPECT_EQ(last.total, 4u);        // frames 1 and 2, two cameras each
+  EXPECT_EQ(last.done, 4u);
+  for (int k = 0; k < 3; ++k)
+    for (int c = 0; c < 4; ++c)
+      EXPECT_EQ(readText(image(c, k)), first[static_cast<std::size_t>(4 * k + c)])
+          << "frame " << k << " camera " << c;
+  for (const auto& e : std::filesystem::recursive_directory_iterator(*drive))
+    EXPECT_NE(e.path().extension(), ".part") << e.path();
+
+  // Another scenario's folder is not resumed.
+  Scenario other = *s;
+  other.source_text += "# another scenario\n";
+  auto refused = renderDrive(other, out.string(), 2, {}, true);
+  ASSERT_FALSE(refused);
+  EXPECT_NE(refused.status().message().find("render_manifest.txt"), std::string::npos)
+      << refused.status().toString();
+
+  // A fresh render of fewer frames leaves none of the longer render's images behind.
+  s->frames = 2;
+  ASSERT_TRUE(renderDrive(*s, out.string(), 2, {}));
+  EXPECT_TRUE(std::filesystem::exists(image(0, 1)));
+  EXPECT_FALSE(std::filesystem::exists(image(0, 2)));
+}
+
 }  // namespace
 }  // namespace sunvo::render

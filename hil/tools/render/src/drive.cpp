@@ -8,6 +8,8 @@
 #include <numbers>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <optional>
+#include <sstream>
 
 #include "sunvo/kitti/oxts.hpp"
 #include "sunvo/kitti/timestamps.hpp"
@@ -26,6 +28,49 @@ Status writeText(const std::string& path, const std::string& text) {
   f << text;
   if (!f) return ioError("write failed: " + path);
   return Status::ok();
+}
+
+std::optional<std::string> readText(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) return std::nullopt;
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+// Writes a PNG under a temporary name and renames it: an image that exists is whole.
+Status writePngAtomically(const std::string& path, const cv::Mat& img) {
+  std::vector<uchar> bytes;
+  if (!cv::imencode(".png", img, bytes)) return ioError("cannot encode " + path);
+  const std::string part = path + ".part";
+  {
+    std::ofstream f(part, std::ios::binary);
+    f.write(reinterpret_cast<const char*>(bytes.data()),
+            static_cast<std::streamsize>(bytes.size()));
+    if (!f) return ioError("cannot write " + part);
+  }
+  std::error_code ec;
+  fs::rename(part, path, ec);
+  if (ec) return ioError("cannot rename " + part + " to " + path + ": " + ec.message());
+  return Status::ok();
+}
+
+// The renderer's output format for a scenario: bump it with any change that renders the same
+// scenario differently, so that a render is not resumed across it.
+constexpr int kRenderFormat = 1;
+
+// What a resumed render must share with the one it continues (renderDrive): the render format,
+// the scenario's text, the camera and the render quality (the --frames override is not in it: a
+// render may be extended).
+std::string renderManifest(const Scenario& s) {
+  char b[512];
+  std::snprintf(b, sizeof b,
+                "render format %d\ncamera %.9g %.9g %.9g %.9g %.9g %d %d\n"
+                "quality %.9g %d %d\nscenario %zu bytes\n",
+                kRenderFormat, s.camera.fu, s.camera.fv, s.camera.cu, s.camera.cv,
+                s.camera.baseline_m, s.camera.width, s.camera.height, s.quality.antialias_threshold,
+                s.quality.antialias_depth, s.quality.quality, s.source_text.size());
+  return b + s.source_text;
 }
 
 std::string row3x4(const Isometry3& T) {
@@ -181,7 +226,8 @@ std::string kittiTimestamp(TimeNs t) {
 }
 
 Expected<std::string> renderDrive(const Scenario& s, const std::string& out_root, int jobs,
-                                  const std::function<void(const DriveProgress&)>& progress) {
+                                  const std::function<void(const DriveProgress&)>& progress,
+                                  bool resume) {
   SUNVO_RETURN_IF_ERROR(s.validate());
   const DriveLook drive_look = drawDriveLook(s.style, s.city);
   const City city = generateCity(drive_look.city, s.seed, drive_look.city_look);
@@ -196,11 +242,33 @@ Expected<std::string> renderDrive(const Scenario& s, const std::string& out_root
   const std::string drive_dir = date_dir + "/" + date + drive_name;
   const std::string pov_dir = drive_dir + "/pov", gt_dir = drive_dir + "/gt";
   std::error_code ec;
+  const std::string manifest_path = drive_dir + "/render_manifest.txt";
+  const std::string manifest = renderManifest(s);
+  if (resume) {
+    const std::optional<std::string> old = readText(manifest_path);
+    if (!old) {
+      return failedPrecondition(drive_dir +
+                                ": no render_manifest.txt, not a render this program can resume "
+                                "(render it without resuming)");
+    }
+    if (*old != manifest) {
+      return failedPrecondition(manifest_path +
+                                ": another scenario, camera, quality or render format; render it "
+                                "without resuming, or into another folder");
+    }
+  } else {
+    // A fresh render: no image or scene of an earlier one may stay behind.
+    for (int c = 0; c < 4; ++c) fs::remove_all(drive_dir + "/image_0" + std::to_string(c), ec);
+    fs::remove_all(pov_dir, ec);
+    fs::remove(manifest_path, ec);
+    ec.clear();
+  }
   for (int c = 0; c < 4; ++c)
     fs::create_directories(drive_dir + "/image_0" + std::to_string(c) + "/data", ec);
   fs::create_directories(pov_dir, ec);
   fs::create_directories(gt_dir, ec);
   if (ec) return ioError("cannot create " + drive_dir + ": " + ec.message());
+  SUNVO_RETURN_IF_ERROR(writeText(manifest_path, manifest));
   SUNVO_RETURN_IF_ERROR(writeKittiCalibration(date_dir, s.camera, s.calib_error));
   SUNVO_RETURN_IF_ERROR(writeText(pov_dir + "/city.inc", povSceneBody(city.scene)));
 
@@ -224,6 +292,8 @@ Expected<std::string> renderDrive(const Scenario& s, const std::string& out_root
       body_csv = "frame,utc_ns,e,n,u,roll_rad,pitch_rad,yaw_rad,ve,vn,vu\n",
       rig_csv = "frame,right_roll_deg,right_pitch_deg,right_yaw_deg\n";
   std::vector<RenderJob> render_jobs;
+  std::vector<int> job_frame;  // the frame of each render job
+  std::size_t kept_frames = 0;
   std::vector<double> gains;
   std::vector<SensorOptions> frame_sensor;  // the look of each frame's camera
   FrameLook look;
@@ -276,12 +346,19 @@ Expected<std::string> renderDrive(const Scenario& s, const std::string& out_root
     if (!cv::imwrite(pov_dir + "/" + name, sky_img))
       return ioError("cannot write sky image " + std::string(name));
     std::snprintf(name, sizeof name, "frame_%06d.pov", k);
-    SUNVO_RETURN_IF_ERROR(
-        writeText(pov_dir + "/" + name,
-                  povFrame({s.camera, s.camera}, {T_g_c0, T_g_c1}, fl.pov, "city.inc", nullptr) +
-                      povPrimitives(trafficAt(traffic, vs.t_s, T_g_b.translation().head<2>(),
-                                              s.traffic, drive_look.city_look))));
-    for (int c = 0; c < 2; ++c) {
+    const std::string pov_text =
+        povFrame({s.camera, s.camera}, {T_g_c0, T_g_c1}, fl.pov, "city.inc", nullptr) +
+        povPrimitives(trafficAt(traffic, vs.t_s, T_g_b.translation().head<2>(), s.traffic,
+                                drive_look.city_look));
+    // Resuming: a frame whose four images exist and whose scene is this one is kept.
+    bool keep = resume && readText(pov_dir + "/" + name) == pov_text;
+    for (int c = 0; c < 4 && keep; ++c) {
+      std::snprintf(buf, sizeof buf, "/image_0%d/data/%010d.png", c, k);
+      keep = fs::exists(drive_dir + buf, ec);
+    }
+    if (keep) ++kept_frames;
+    if (!keep) SUNVO_RETURN_IF_ERROR(writeText(pov_dir + "/" + name, pov_text));
+    for (int c = 0; c < 2 && !keep; ++c) {
       RenderJob j;
       j.work_dir = pov_dir;
       j.pov_file = name;
@@ -293,6 +370,7 @@ Expected<std::string> renderDrive(const Scenario& s, const std::string& out_root
       j.height = s.camera.height;
       j.cam_index = c;
       render_jobs.push_back(j);
+      job_frame.push_back(k);
     }
     if (k > 0) log_gain = 0.9 * log_gain + s.sensor.exposure_sigma * N01(exp_rng);
     gains.push_back(std::exp(log_gain));
@@ -348,14 +426,15 @@ Expected<std::string> renderDrive(const Scenario& s, const std::string& out_root
         kitti::writeRawTimestamps(drive_dir + "/oxts/timestamps.txt", times_all, 0));
   }
 
-  DriveProgress prog{0, render_jobs.size()};
+  DriveProgress prog{0, render_jobs.size(), kept_frames};
+  if (progress) progress(prog);
   Status post;
   const Status st =
       runPovrayJobs(render_jobs, s.quality, jobs, [&](std::size_t i, const Status& js) {
         ++prog.done;
         if (js.isOk() && post.isOk()) {
           const RenderJob& j = render_jobs[i];
-          const int k = static_cast<int>(i / 2), c = static_cast<int>(i % 2);
+          const int k = job_frame[i], c = j.cam_index;
           const std::string raw = j.work_dir + "/" + j.output_png;
           const cv::Mat img = cv::imread(raw, cv::IMREAD_COLOR);
           if (img.empty()) {
@@ -369,9 +448,9 @@ Expected<std::string> renderDrive(const Scenario& s, const std::string& out_root
             cv::cvtColor(sens, gray, cv::COLOR_BGR2GRAY);
             char fn[32];
             std::snprintf(fn, sizeof fn, "/data/%010d.png", k);
-            if (!cv::imwrite(drive_dir + "/image_0" + std::to_string(c) + fn, gray) ||
-                !cv::imwrite(drive_dir + "/image_0" + std::to_string(c + 2) + fn, sens)) {
-              post = ioError("cannot write images of frame " + std::to_string(k));
+            post = writePngAtomically(drive_dir + "/image_0" + std::to_string(c) + fn, gray);
+            if (post.isOk()) {
+              post = writePngAtomically(drive_dir + "/image_0" + std::to_string(c + 2) + fn, sens);
             }
             fs::remove(raw, ec);
           }

@@ -237,6 +237,7 @@ Expected<Scenario> parseScenario(const std::string& text, const std::string& lab
   }
   SUNVO_RETURN_IF_ERROR(r.st);
   if (auto st = s.validate(); !st.isOk()) return invalidArgument(label + ": " + st.message());
+  s.source_text = text;
   return s;
 }
 

@@ -85,6 +85,9 @@ struct Scenario {
   StyleOptions style;  // domain randomisation of the look (style.hpp); seed 0 = classic
   CalibErrorOptions calib_error;
   RigErrorOptions rig_error;
+  // The YAML text it was parsed from (parseScenario): part of a render's manifest, so that a
+  // render is resumed only with the scenario it was started with.
+  std::string source_text;
   Status validate() const;
 };
 
@@ -117,12 +120,20 @@ Status writeKittiCalibration(const std::string& date_dir, const StereoCamera& ca
 std::string kittiTimestamp(TimeNs t);
 
 struct DriveProgress {
-  std::size_t done = 0, total = 0;
+  std::size_t done = 0, total = 0;  // povray renders of this run
+  std::size_t kept_frames = 0;      // frames a resumed render found done
 };
 
 // Renders the whole drive (2 povray renders per frame) with `jobs` parallel povray children.
-// Returns the drive folder.
+// Returns the drive folder. Every image is written under a temporary name and renamed, so an
+// image that exists is whole. A fresh render (resume = false) first removes the drive's images
+// and scene files. resume = true continues a render that stopped part-way (a killed run, the end
+// of a session): the folder's render_manifest.txt (the program's version, the scenario's text, the
+// camera and the render quality) must be this run's, and a frame is kept when its four images
+// exist and its POV-Ray scene (frame_NNNNNN.pov) is the one this run writes, byte for byte; the
+// rest is rendered. The ground truth, OXTS and calibration are written again either way.
 Expected<std::string> renderDrive(const Scenario& s, const std::string& out_root, int jobs,
-                                  const std::function<void(const DriveProgress&)>& progress);
+                                  const std::function<void(const DriveProgress&)>& progress,
+                                  bool resume = false);
 
 }  // namespace sunvo::render
