@@ -128,7 +128,7 @@ struct DriveProgress {
 // Returns the drive folder. Every image is written under a temporary name and renamed, so an
 // image that exists is whole. A fresh render (resume = false) first removes the drive's images
 // and scene files. resume = true continues a render that stopped part-way (a killed run, the end
-// of a session): the folder's render_manifest.txt (the program's version, the scenario's text, the
+// of a session): the folder's render_manifest.txt (the render format, the scenario's text, the
 // camera and the render quality) must be this run's, and a frame is kept when its four images
 // exist and its POV-Ray scene (frame_NNNNNN.pov) is the one this run writes, byte for byte; the
 // rest is rendered. The ground truth, OXTS and calibration are written again either way.
