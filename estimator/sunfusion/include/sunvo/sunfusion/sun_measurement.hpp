@@ -44,7 +44,7 @@ inline Eigen::Matrix3d directionSqrtInformation(const Eigen::Vector3d& sun_c, do
   }
   const Eigen::Vector3d a = strong_axis_c - strong_axis_c.dot(sun_c) * sun_c;
   const double n = a.norm();
-  if (!(n > 0.0) || !(n > 1e-6 * strong_axis_c.norm())) return W;
+  if (!(n > 1e-6 * strong_axis_c.norm())) return W;  // also a zero axis (n = 0)
   const Eigen::Vector3d u = a / n;
   W += (1.0 / sigma_strong - 1.0 / sigma) * u * u.transpose();
   return W;
