@@ -418,6 +418,8 @@ TEST(SunFusionOptionsTest, ValidationNamesTheBadKey) {
   const std::vector<std::pair<Set, const char*>> cases = {
       // min_drift: above max_drift
       {[](SunFusionOptions& o) { o.min_drift_deg_per_frame = 1.0; }, "min_drift_deg_per_frame"},
+      {[](SunFusionOptions& o) { o.vertical_max_drift_deg_per_frame = 0.001; },
+       "vertical_max_drift_deg_per_frame"},
       {[](SunFusionOptions& o) { o.drift_adaptation_rate = 0.0; }, "drift_adaptation_rate"},
       {[](SunFusionOptions& o) { o.persistence_false_alarm = 0.0; }, "persistence_false_alarm"},
       {[](SunFusionOptions& o) { o.persistence_forgetting = 1.0; }, "persistence_forgetting"},

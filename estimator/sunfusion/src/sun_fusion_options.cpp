@@ -34,6 +34,11 @@ Status SunFusionOptions::validate() const {
     return invalidArgument(
         "fusion.min_drift_deg_per_frame / max_drift_deg_per_frame: need 0 <= min <= max <= 5");
   }
+  if (!(vertical_max_drift_deg_per_frame >= min_drift_deg_per_frame &&
+        vertical_max_drift_deg_per_frame <= 5.0)) {
+    return invalidArgument(
+        "fusion.vertical_max_drift_deg_per_frame out of range [min_drift_deg_per_frame, 5]");
+  }
   if (!(drift_adaptation_rate > 0.0 && drift_adaptation_rate <= 1.0)) {
     return invalidArgument("fusion.drift_adaptation_rate out of range (0, 1]");
   }

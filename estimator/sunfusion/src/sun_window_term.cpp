@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "sunvo/core/geometry.hpp"
+#include "sunvo/sunfusion/persistence_statistic.hpp"
 #include "sunvo/sunfusion/sun_residual.hpp"
 
 namespace sunvo::sunfusion {
@@ -18,24 +19,6 @@ using RowsJacobian = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor, 3
 using RowsSquare = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 3, 3>;
 using RowsVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 3, 1>;
 
-// Chi-square CDF for 1, 2 or 3 degrees of freedom (closed forms).
-double chiSquareCdf(double x, int dof) {
-  if (x <= 0.0) return 0.0;
-  const double e = std::erf(std::sqrt(0.5 * x));
-  if (dof == 1) return e;
-  if (dof == 2) return 1.0 - std::exp(-0.5 * x);
-  return e - std::sqrt(2.0 * x / M_PI) * std::exp(-0.5 * x);
-}
-
-// x with chiSquareCdf(x, dof) = p, by bisection (p in (0, 1)).
-double chiSquareQuantile(double p, int dof) {
-  double lo = 0.0, hi = 200.0;
-  for (int i = 0; i < 100; ++i) {
-    const double mid = 0.5 * (lo + hi);
-    (chiSquareCdf(mid, dof) < p ? lo : hi) = mid;
-  }
-  return 0.5 * (lo + hi);
-}
 }  // namespace
 
 Status SunWindowTerm::init(const SunFusionOptions& options) {
@@ -62,6 +45,7 @@ Status SunWindowTerm::init(const SunFusionOptions& options) {
   persistence_I_.setZero();
   sun_g_.setZero();
   sun_I_.setZero();
+  vertical_in_sums_ = false;
   persistence_T_ = 0.0;
   persistence_bound_[0] = 0.0;
   for (int dof = 1; dof <= 3; ++dof) {
@@ -417,19 +401,35 @@ void SunWindowTerm::adaptDrift(const Innovation& inn, const Eigen::Matrix3d& C_w
       // caps an outlier's pull at persistence_huber sigmas per row.
       accumulate(inn, C_w_b, &persistence_I_, &persistence_g_);
       std::size_t rank = 0;
-      persistence_T_ = persistenceStatistic(persistence_I_, persistence_g_, &rank);
+      persistence_T_ = sunfusion::persistenceStatistic(persistence_I_, persistence_g_, &rank);
       step = rank > 0 && persistence_T_ > persistence_bound_[rank]
                  ? options_.persistence_step_up
                  : -options_.persistence_step_down;
       if (splitByGravity()) {
-        // The tilt's walk steps on every measurement's test (all channels); the heading's only on
-        // the sun's, from sums of the sun's measurements alone: an "up" never sees the heading.
-        // Without vertical measurements both sums, tests and walks are the same.
-        drift_deg_per_frame_ = clampDrift(drift_deg_per_frame_ * std::exp(step));
+        // The heading's walk steps on the sun's measurements only, on sums of the sun's alone: an
+        // "up" never sees the heading. The tilt's walk steps on every measurement, up to the cap
+        // of the measurement's channel; once the vertical channel is in the sums, on the tilt's
+        // part of the test of all channels' sums (tiltPersistenceStatistic), which a sun that
+        // informs the tilt little (an azimuth-only 15 deg beside a 0.1 deg "up") does not dilute.
+        // Without vertical measurements the sun steps both walks on the same test, as one.
+        if (channel == 1) vertical_in_sums_ = true;
+        if (vertical_in_sums_) {
+          std::size_t tilt_rank = 0;
+          const double T_tilt =
+              tiltPersistenceStatistic(persistence_I_, persistence_g_, worldUp(), &tilt_rank);
+          const double step_t = tilt_rank > 0 && T_tilt > persistence_bound_[tilt_rank]
+                                    ? options_.persistence_step_up
+                                    : -options_.persistence_step_down;
+          const double cap = channel == 0 ? options_.max_drift_deg_per_frame
+                                          : options_.vertical_max_drift_deg_per_frame;
+          drift_deg_per_frame_ = stepDrift(drift_deg_per_frame_, step_t, cap);
+        } else {
+          drift_deg_per_frame_ = clampDrift(drift_deg_per_frame_ * std::exp(step));
+        }
         if (channel == 0) {
           accumulate(inn, C_w_b, &sun_I_, &sun_g_);
           std::size_t sun_rank = 0;
-          const double T = persistenceStatistic(sun_I_, sun_g_, &sun_rank);
+          const double T = sunfusion::persistenceStatistic(sun_I_, sun_g_, &sun_rank);
           const double step_h = sun_rank > 0 && T > persistence_bound_[sun_rank]
                                     ? options_.persistence_step_up
                                     : -options_.persistence_step_down;
@@ -448,23 +448,11 @@ double SunWindowTerm::clampDrift(double q) const {
   return std::clamp(q, options_.min_drift_deg_per_frame, options_.max_drift_deg_per_frame);
 }
 
-double SunWindowTerm::persistenceStatistic(const Eigen::Matrix3d& I, const Eigen::Vector3d& g,
-                                           std::size_t* rank) {
-  // Pseudo-inverse: one sun direction never informs the rotation about itself, and directions
-  // with less than 1e-3 of the strongest information count as unobserved (rank drops).
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(I);
-  const double floor = 1e-3 * std::max(eig.eigenvalues().maxCoeff(), 1e-300);
-  double T = 0.0;
-  *rank = 0;
-  for (int i = 0; i < 3; ++i) {
-    const double l = eig.eigenvalues()(i);
-    if (l > floor) {
-      const double proj = eig.eigenvectors().col(i).dot(g);
-      T += proj * proj / l;
-      ++*rank;
-    }
-  }
-  return T;
+double SunWindowTerm::stepDrift(double q, double step, double cap) const {
+  const double next = q * std::exp(step);
+  if (step > 0.0)
+    return std::max(std::min(next, std::max(cap, q)), options_.min_drift_deg_per_frame);
+  return std::max(next, options_.min_drift_deg_per_frame);
 }
 
 void SunWindowTerm::accumulate(const Innovation& inn, const Eigen::Matrix3d& C_w_b,

@@ -39,10 +39,16 @@
 //      max_drift_deg_per_frame.
 //      With split_drift_by_gravity (default) the walk has two sizes: q_tilt on the plane normal to
 //      world_up, q_heading along it (P += N (q_tilt^2 (I - u u^T) + q_heading^2 u u^T)). q_tilt
-//      steps on the test of all channels' sums; q_heading only on sun measurements, on the test of
-//      sums of the sun's measurements alone. A precise "up" (vertical channel) that evidences a
-//      tilt drift thus no longer widens the heading, which a 12-20 deg sun would then pull around
-//      (measured: docs/vertical.md). Without vertical measurements both are the same q_theta.
+//      steps on every measurement; once a vertical measurement is in the sums, on the tilt's part
+//      of the test of all channels' sums (T_t = e_t^T C^+ e_t, e_t and C the tilt components of
+//      I^+ g and I^+), so a sun that informs the tilt little does not dilute it, and up to the
+//      cap of the measurement's channel (max_drift_deg_per_frame for the sun,
+//      vertical_max_drift_deg_per_frame for the vertical channel). q_heading steps only on sun
+//      measurements, on the test of sums of the sun's measurements alone. A precise "up"
+//      (vertical channel) that evidences a tilt drift thus no longer widens the heading, which a
+//      12-20 deg sun would then pull around, and an image estimator's low cap no longer holds
+//      the tilt's walk down (measured: docs/vertical.md). Without vertical measurements both are
+//      the same q_theta.
 //    * kInnovationMedian: one log-step up when a measurement's r^T S^-1 r exceeds the chi-square
 //      median of its rows, one down otherwise. With a correct R_s and P << R_s this rule walks
 //      at random, and outliers push it up: kept for comparison (docs/experiment.md).
@@ -183,6 +189,13 @@ struct SunFusionOptions {
   // constant part of VO's drift on the worst route measured (0.018 deg/frame, real 0020 tracks);
   // raise it for sources with independent errors (docs/experiment.md, ablations).
   double max_drift_deg_per_frame = 0.05;
+  // deg/frame, [min, 5]: with split_drift_by_gravity, the cap up to which the vertical channel's
+  // own evidence may raise the tilt's walk. max_drift_deg_per_frame bounds the walks the sun's
+  // measurements raise (an image estimator's is lowered for its street-long errors,
+  // ImageEstimatorFusion); the cue's errors are not the sun's, so that bound is not the cue's
+  // either (measured: docs/vertical.md, "Two channels, two caps"). 0.05 = the default of
+  // max_drift_deg_per_frame, the cap of the cue alone.
+  double vertical_max_drift_deg_per_frame = 0.05;
   double drift_adaptation_rate = 0.1;  // (0, 1]: log-step of q_theta per measurement (median rule)
   // Persistence rule: forgetting factor of the sums per measurement, (0, 1) (0.98: about the last
   // 50 measurements); false-alarm probability of the test on T, (0, 0.5]; log-steps up and down
@@ -193,8 +206,8 @@ struct SunFusionOptions {
   double persistence_step_up = 0.5;
   double persistence_step_down = 0.1;
   double persistence_huber = 2.0;
-  // Persistence rule: one q_theta for the tilt (roll/pitch: the plane normal to world_up), tested
-  // on every channel, and one for the heading (about world_up), tested on the sun's measurements
+  // Persistence rule: one q_theta for the tilt (roll/pitch: the plane normal to world_up), stepped
+  // by every channel, and one for the heading (about world_up), tested on the sun's measurements
   // only (header comment); false = one q_theta for all three axes, as before 2026-11-26. The
   // same without vertical measurements.
   bool split_drift_by_gravity = true;
@@ -239,6 +252,7 @@ struct SunFusionOptions {
     v("drift_adaptation", s.drift_adaptation);
     v("min_drift_deg_per_frame", s.min_drift_deg_per_frame);
     v("max_drift_deg_per_frame", s.max_drift_deg_per_frame);
+    v("vertical_max_drift_deg_per_frame", s.vertical_max_drift_deg_per_frame);
     v("drift_adaptation_rate", s.drift_adaptation_rate);
     v("persistence_forgetting", s.persistence_forgetting);
     v("persistence_false_alarm", s.persistence_false_alarm);
@@ -425,9 +439,9 @@ class SunWindowTerm {
   void adaptDrift(const Innovation& inn, const Eigen::Matrix3d& C_w_b, int channel);
   bool splitByGravity() const;
   double clampDrift(double q) const;
-  // T = g^T I^+ g and the rank of I (the persistence test).
-  static double persistenceStatistic(const Eigen::Matrix3d& I, const Eigen::Vector3d& g,
-                                     std::size_t* rank);
+  // One log-step of a walk q raised by a channel whose evidence may take it up to cap: a step up
+  // stops at max(cap, q) (another channel's larger cap is not undone), a step down at the floor.
+  double stepDrift(double q, double step, double cap) const;
   // Adds an accepted measurement to forgotten sums I and g (world frame).
   void accumulate(const Innovation& inn, const Eigen::Matrix3d& C_w_b, Eigen::Matrix3d* I,
                   Eigen::Vector3d* g) const;
@@ -461,6 +475,7 @@ class SunWindowTerm {
   Eigen::Matrix3d persistence_I_ = Eigen::Matrix3d::Zero();  // forgotten sum of H^T H
   Eigen::Vector3d sun_g_ = Eigen::Vector3d::Zero();  // the same sums, sun channel only (split)
   Eigen::Matrix3d sun_I_ = Eigen::Matrix3d::Zero();
+  bool vertical_in_sums_ = false;  // a vertical measurement has stepped the tilt's walk
   double persistence_T_ = 0.0;
   std::array<double, 4> persistence_bound_{};  // chi-square quantile by rank 1..3
   std::optional<std::uint64_t> last_sequence_;
