@@ -15,6 +15,31 @@ double chiSquareCdf(double x, int dof) {
   return e - std::sqrt(2.0 * x / M_PI) * std::exp(-0.5 * x);
 }
 
+// v^T A^+ v: the sum of (w^T v)^2 / l over A's eigen-pairs (l, w) with l above rel_floor times the
+// largest (the others count as unobserved); *rank: how many were kept; A^+ of those when asked.
+template <int N>
+double pseudoInverseForm(const Eigen::Matrix<double, N, N>& A, const Eigen::Matrix<double, N, 1>& v,
+                         double rel_floor, std::size_t* rank,
+                         Eigen::Matrix<double, N, N>* A_plus = nullptr) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, N, N>> eig(A);
+  const double floor = rel_floor * std::max(eig.eigenvalues().maxCoeff(), 1e-300);
+  if (A_plus != nullptr) A_plus->setZero();
+  double T = 0.0;
+  *rank = 0;
+  for (int i = 0; i < N; ++i) {
+    const double l = eig.eigenvalues()(i);
+    if (l > floor) {
+      const double proj = eig.eigenvectors().col(i).dot(v);
+      T += proj * proj / l;
+      ++*rank;
+      if (A_plus != nullptr) {
+        *A_plus += eig.eigenvectors().col(i) * eig.eigenvectors().col(i).transpose() / l;
+      }
+    }
+  }
+  return T;
+}
+
 }  // namespace
 
 double chiSquareQuantile(double p, int dof) {
@@ -27,56 +52,25 @@ double chiSquareQuantile(double p, int dof) {
 }
 
 double persistenceStatistic(const Eigen::Matrix3d& I, const Eigen::Vector3d& g, std::size_t* rank) {
-  // Pseudo-inverse: one sun direction never informs the rotation about itself, and directions
-  // with less than 1e-3 of the strongest information count as unobserved (rank drops).
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(I);
-  const double floor = 1e-3 * std::max(eig.eigenvalues().maxCoeff(), 1e-300);
-  double T = 0.0;
-  *rank = 0;
-  for (int i = 0; i < 3; ++i) {
-    const double l = eig.eigenvalues()(i);
-    if (l > floor) {
-      const double proj = eig.eigenvectors().col(i).dot(g);
-      T += proj * proj / l;
-      ++*rank;
-    }
-  }
-  return T;
+  // One sun direction never informs the rotation about itself, and directions with less than
+  // 1e-3 of the strongest information count as unobserved (rank drops).
+  return pseudoInverseForm<3>(I, g, 1e-3, rank);
 }
 
 double tiltPersistenceStatistic(const Eigen::Matrix3d& I, const Eigen::Vector3d& g,
                                 const Eigen::Vector3d& up, std::size_t* rank) {
-  // The least-squares error estimate e = I^+ g has covariance I^+ under noise alone (the
-  // pseudo-inverse as in persistenceStatistic). Its tilt part e_t = B^T e (B: two unit vectors
-  // normal to up) has covariance C = B^T I^+ B, so T_t = e_t^T C^+ e_t is chi-square with rank(C)
-  // dof: the test of a tilt drift alone, which a channel that informs only the heading (an
-  // azimuth-only sun of 15 deg beside a 0.1 deg "up") neither dilutes nor raises.
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(I);
-  const double floor = 1e-3 * std::max(eig.eigenvalues().maxCoeff(), 1e-300);
-  Eigen::Matrix3d I_plus = Eigen::Matrix3d::Zero();
-  for (int i = 0; i < 3; ++i) {
-    const double l = eig.eigenvalues()(i);
-    if (l > floor) I_plus += eig.eigenvectors().col(i) * eig.eigenvectors().col(i).transpose() / l;
-  }
-  const Eigen::Vector3d e = I_plus * g;
+  // e = I^+ g has covariance I^+ under noise alone (I^+ as in persistenceStatistic); its tilt part
+  // e_t = B^T e (B: two unit vectors normal to up) has covariance C = B^T I^+ B, and
+  // T_t = e_t^T C^+ e_t is chi-square with rank(C) dof.
+  Eigen::Matrix3d I_plus;
+  std::size_t rank_I = 0;
+  pseudoInverseForm<3>(I, g, 1e-3, &rank_I, &I_plus);
   const Eigen::Vector3d b1 = up.unitOrthogonal();
   Eigen::Matrix<double, 3, 2> B;
   B << b1, up.cross(b1).normalized();
   const Eigen::Matrix2d C = B.transpose() * I_plus * B;
-  const Eigen::Vector2d e_t = B.transpose() * e;
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig_c(C);
-  const double c_floor = 1e-9 * std::max(eig_c.eigenvalues().maxCoeff(), 1e-300);
-  double T = 0.0;
-  *rank = 0;
-  for (int i = 0; i < 2; ++i) {
-    const double c = eig_c.eigenvalues()(i);
-    if (c > c_floor) {
-      const double proj = eig_c.eigenvectors().col(i).dot(e_t);
-      T += proj * proj / c;
-      ++*rank;
-    }
-  }
-  return T;
+  const Eigen::Vector2d e_t = B.transpose() * (I_plus * g);
+  return pseudoInverseForm<2>(C, e_t, 1e-9, rank);
 }
 
 }  // namespace sunvo::sunfusion
