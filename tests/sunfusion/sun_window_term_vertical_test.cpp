@@ -80,11 +80,11 @@ TEST_F(SunWindowTermTest, VerticalChannelIsCountedApartAndSplitsTheWalkByGravity
 }
 
 // A noisy azimuth-only sun beside the "up" (Sun-CNN beside the vertical cue): the tilt's walk is
-// the vertical channel's to raise, up to the channel's own cap, and on the tilt's part of the test,
-// so neither the image estimator's lower cap (which bounds what its street-long errors can turn)
-// nor its heading information holds the tilt's walk down; the heading's walk keeps the sun's cap.
-// Before 2026-11-28 the sun's cap bounded both walks (0.01 here), measured on a held-out render as
-// a tilt 0.205 deg RMS with Sun-CNN and the cue against 0.113 with the cue alone.
+// the vertical channel's to step, up to that channel's cap, on the tilt's part of the test, so
+// neither the image estimator's lower cap (which bounds what its street-long errors can turn) nor
+// its heading information holds the tilt's walk down; the heading's walk keeps the sun's cap.
+// Before 2026-11-28 the sun's cap bounded both walks (0.01 here), measured on renders as a tilt
+// 0.30 deg RMS with Sun-CNN and the cue against 0.22 with the cue alone (docs/vertical.md).
 TEST_F(SunWindowTermTest, ANoisySunBesideTheVerticalLeavesTheTiltWalkToTheVertical) {
   SunFusionOptions opt = baseAttitudeOptions();
   opt.initial_attitude_sigma_deg = 0.1;

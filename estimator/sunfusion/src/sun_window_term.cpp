@@ -406,24 +406,25 @@ void SunWindowTerm::adaptDrift(const Innovation& inn, const Eigen::Matrix3d& C_w
                  ? options_.persistence_step_up
                  : -options_.persistence_step_down;
       if (splitByGravity()) {
-        // The heading's walk steps on the sun's measurements only, on sums of the sun's alone: an
-        // "up" never sees the heading. The tilt's walk steps on every measurement, up to the cap
-        // of the measurement's channel; once the vertical channel is in the sums, on the tilt's
-        // part of the test of all channels' sums (tiltPersistenceStatistic), which a sun that
-        // informs the tilt little (an azimuth-only 15 deg beside a 0.1 deg "up") does not dilute.
-        // Without vertical measurements the sun steps both walks on the same test, as one.
+        // Each walk steps with the channel that measures it. The heading's on the sun's
+        // measurements, from sums of the sun's alone: an "up" never sees the heading. The tilt's,
+        // once a vertical measurement is in the sums, on the vertical channel's, up to that
+        // channel's cap, on the tilt's part of the test of all channels' sums
+        // (tiltPersistenceStatistic): a sun beside it that informs the tilt little (an
+        // azimuth-only 15 deg beside a 0.1 deg "up") neither dilutes the test, nor holds the walk
+        // to the sun's cap, nor steps it a second time per frame on the cue's evidence. Without
+        // vertical measurements the sun steps both walks on the same test, as one.
         if (channel == 1) vertical_in_sums_ = true;
-        if (vertical_in_sums_) {
+        if (channel == 1) {
           std::size_t tilt_rank = 0;
           const double T_tilt =
               tiltPersistenceStatistic(persistence_I_, persistence_g_, worldUp(), &tilt_rank);
           const double step_t = tilt_rank > 0 && T_tilt > persistence_bound_[tilt_rank]
                                     ? options_.persistence_step_up
                                     : -options_.persistence_step_down;
-          const double cap = channel == 0 ? options_.max_drift_deg_per_frame
-                                          : options_.vertical_max_drift_deg_per_frame;
-          drift_deg_per_frame_ = stepDrift(drift_deg_per_frame_, step_t, cap);
-        } else {
+          drift_deg_per_frame_ =
+              stepDrift(drift_deg_per_frame_, step_t, options_.vertical_max_drift_deg_per_frame);
+        } else if (!vertical_in_sums_) {
           drift_deg_per_frame_ = clampDrift(drift_deg_per_frame_ * std::exp(step));
         }
         if (channel == 0) {

@@ -38,17 +38,17 @@
 //      alone and rises only when the evidence of a drift accumulates, up to
 //      max_drift_deg_per_frame.
 //      With split_drift_by_gravity (default) the walk has two sizes: q_tilt on the plane normal to
-//      world_up, q_heading along it (P += N (q_tilt^2 (I - u u^T) + q_heading^2 u u^T)). q_tilt
-//      steps on every measurement; once a vertical measurement is in the sums, on the tilt's part
-//      of the test of all channels' sums (T_t = e_t^T C^+ e_t, e_t and C the tilt components of
-//      I^+ g and I^+), so a sun that informs the tilt little does not dilute it, and up to the
-//      cap of the measurement's channel (max_drift_deg_per_frame for the sun,
-//      vertical_max_drift_deg_per_frame for the vertical channel). q_heading steps only on sun
-//      measurements, on the test of sums of the sun's measurements alone. A precise "up"
-//      (vertical channel) that evidences a tilt drift thus no longer widens the heading, which a
-//      12-20 deg sun would then pull around, and an image estimator's low cap no longer holds
-//      the tilt's walk down (measured: docs/vertical.md). Without vertical measurements both are
-//      the same q_theta.
+//      world_up, q_heading along it (P += N (q_tilt^2 (I - u u^T) + q_heading^2 u u^T)). Each
+//      steps with the channel that measures it: q_heading on sun measurements only, on the test of
+//      sums of the sun's measurements alone, up to max_drift_deg_per_frame; q_tilt, once a
+//      vertical measurement is in the sums, on the vertical channel's measurements only, on the
+//      tilt's part of the test of all channels' sums (T_t = e_t^T C^+ e_t, e_t and C the tilt
+//      components of I^+ g and I^+; persistence_statistic.hpp), up to
+//      vertical_max_drift_deg_per_frame. A precise "up" that evidences a tilt drift thus no
+//      longer widens the heading, which a 12-20 deg sun would then pull around; and a sun beside
+//      the "up" neither dilutes the tilt's test, nor holds its walk to an image estimator's low
+//      cap, nor steps it a second time per frame (measured: docs/vertical.md). Without vertical
+//      measurements both are the same q_theta.
 //    * kInnovationMedian: one log-step up when a measurement's r^T S^-1 r exceeds the chi-square
 //      median of its rows, one down otherwise. With a correct R_s and P << R_s this rule walks
 //      at random, and outliers push it up: kept for comparison (docs/experiment.md).
@@ -189,8 +189,8 @@ struct SunFusionOptions {
   // constant part of VO's drift on the worst route measured (0.018 deg/frame, real 0020 tracks);
   // raise it for sources with independent errors (docs/experiment.md, ablations).
   double max_drift_deg_per_frame = 0.05;
-  // deg/frame, [min, 5]: with split_drift_by_gravity, the cap up to which the vertical channel's
-  // own evidence may raise the tilt's walk. max_drift_deg_per_frame bounds the walks the sun's
+  // deg/frame, [min, 5]: with split_drift_by_gravity, the cap up to which the vertical channel
+  // raises the tilt's walk. max_drift_deg_per_frame bounds the walks the sun's
   // measurements raise (an image estimator's is lowered for its street-long errors,
   // ImageEstimatorFusion); the cue's errors are not the sun's, so that bound is not the cue's
   // either (measured: docs/vertical.md, "Two channels, two caps"). 0.05 = the default of
@@ -207,9 +207,9 @@ struct SunFusionOptions {
   double persistence_step_down = 0.1;
   double persistence_huber = 2.0;
   // Persistence rule: one q_theta for the tilt (roll/pitch: the plane normal to world_up), stepped
-  // by every channel, and one for the heading (about world_up), tested on the sun's measurements
-  // only (header comment); false = one q_theta for all three axes, as before 2026-11-26. The
-  // same without vertical measurements.
+  // by the vertical channel once it measures, and one for the heading (about world_up), tested on
+  // the sun's measurements only (header comment); false = one q_theta for all three axes, as before
+  // 2026-11-26. The same without vertical measurements.
   bool split_drift_by_gravity = true;
   // Innovation gate bound on r^T S^-1 r, [0, 1e6]; 0 = off. 16.3 = chi-square 3 dof, 99.9 %.
   double innovation_gate_chi2 = 16.3;
