@@ -414,8 +414,8 @@ void SunWindowTerm::adaptDrift(const Innovation& inn, const Eigen::Matrix3d& C_w
         // azimuth-only 15 deg beside a 0.1 deg "up") neither dilutes the test, nor holds the walk
         // to the sun's cap, nor steps it a second time per frame on the cue's evidence. Without
         // vertical measurements the sun steps both walks on the same test, as one.
-        if (channel == 1) vertical_in_sums_ = true;
         if (channel == 1) {
+          vertical_in_sums_ = true;
           std::size_t tilt_rank = 0;
           const double T_tilt =
               tiltPersistenceStatistic(persistence_I_, persistence_g_, worldUp(), &tilt_rank);
@@ -451,9 +451,8 @@ double SunWindowTerm::clampDrift(double q) const {
 
 double SunWindowTerm::stepDrift(double q, double step, double cap) const {
   const double next = q * std::exp(step);
-  if (step > 0.0)
-    return std::max(std::min(next, std::max(cap, q)), options_.min_drift_deg_per_frame);
-  return std::max(next, options_.min_drift_deg_per_frame);
+  const double upper = step > 0.0 ? std::max(cap, q) : next;
+  return std::max(std::min(next, upper), options_.min_drift_deg_per_frame);
 }
 
 void SunWindowTerm::accumulate(const Innovation& inn, const Eigen::Matrix3d& C_w_b,
