@@ -398,8 +398,11 @@ void SunWindowTerm::adaptDrift(const Innovation& inn, const Eigen::Matrix3d& C_w
       // them, I^+ g with g = sum H_i^T r_i and I = sum H_i^T H_i, has the chi-square statistic
       // T = g^T I^+ g with rank(I) dof when dtheta_w = 0 (noise only). The sums forget by
       // persistence_forgetting per measurement, so T weighs the recent drift; a Huber weight
-      // caps an outlier's pull at persistence_huber sigmas per row.
-      accumulate(inn, C_w_b, &persistence_I_, &persistence_g_);
+      // caps an outlier's pull at persistence_huber sigmas per row. Once the vertical channel
+      // steps the tilt's walk (split below), the sums forget on its answers only: a sun answer
+      // between two of them would halve the memory of the cue's evidence the tilt's test reads.
+      const bool forget = !(splitByGravity() && channel == 0 && vertical_in_sums_);
+      accumulate(inn, C_w_b, &persistence_I_, &persistence_g_, forget);
       std::size_t rank = 0;
       persistence_T_ = sunfusion::persistenceStatistic(persistence_I_, persistence_g_, &rank);
       step = rank > 0 && persistence_T_ > persistence_bound_[rank]
@@ -456,7 +459,7 @@ double SunWindowTerm::stepDrift(double q, double step, double cap) const {
 }
 
 void SunWindowTerm::accumulate(const Innovation& inn, const Eigen::Matrix3d& C_w_b,
-                               Eigen::Matrix3d* I, Eigen::Vector3d* g) const {
+                               Eigen::Matrix3d* I, Eigen::Vector3d* g, bool forget) const {
   // Fixed-size, with the rows past m zero (no heap allocation).
   const int m = inn.dof;
   Eigen::Matrix3d J = inn.J;
@@ -467,7 +470,8 @@ void SunWindowTerm::accumulate(const Innovation& inn, const Eigen::Matrix3d& C_w
   const double cap = options_.persistence_huber * std::sqrt(static_cast<double>(m));
   const double norm = r.norm();
   const double w = norm > cap ? cap / norm : 1.0;
-  const double lambda = options_.drift_adaptation == DriftAdaptation::kEvidence
+  const double lambda = !forget ? 1.0
+                        : options_.drift_adaptation == DriftAdaptation::kEvidence
                             ? options_.evidence_forgetting
                             : options_.persistence_forgetting;
   *g = lambda * *g + H.transpose() * (w * r);

@@ -442,9 +442,10 @@ class SunWindowTerm {
   // One log-step of a walk q raised by a channel whose evidence may take it up to cap: a step up
   // stops at max(cap, q) (another channel's larger cap is not undone), a step down at the floor.
   double stepDrift(double q, double step, double cap) const;
-  // Adds an accepted measurement to forgotten sums I and g (world frame).
+  // Adds an accepted measurement to forgotten sums I and g (world frame); forget = false adds it
+  // without forgetting the sums first.
   void accumulate(const Innovation& inn, const Eigen::Matrix3d& C_w_b, Eigen::Matrix3d* I,
-                  Eigen::Vector3d* g) const;
+                  Eigen::Vector3d* g, bool forget = true) const;
   // Evidence rule: widens P along directions where I^+ g stands out of its noise.
   void inflateToEvidence();
 
