@@ -44,11 +44,12 @@
 //      vertical measurement is in the sums, on the vertical channel's measurements only, on the
 //      tilt's part of the test of all channels' sums (T_t = e_t^T C^+ e_t, e_t and C the tilt
 //      components of I^+ g and I^+; persistence_statistic.hpp), up to
-//      vertical_max_drift_deg_per_frame. A precise "up" that evidences a tilt drift thus no
-//      longer widens the heading, which a 12-20 deg sun would then pull around; and a sun beside
-//      the "up" neither dilutes the tilt's test, nor holds its walk to an image estimator's low
-//      cap, nor steps it a second time per frame (measured: docs/vertical.md). Without vertical
-//      measurements both are the same q_theta.
+//      vertical_max_drift_deg_per_frame, and the sun's answers then add to those sums without
+//      forgetting them (they forget on the cue's answers). A precise "up" that evidences a tilt
+//      drift thus no longer widens the heading, which a 12-20 deg sun would then pull around; and
+//      a sun beside the "up" neither dilutes the tilt's test, nor holds its walk to an image
+//      estimator's low cap, nor steps it a second time per frame, nor shortens its memory
+//      (measured: docs/vertical.md). Without vertical measurements both are the same q_theta.
 //    * kInnovationMedian: one log-step up when a measurement's r^T S^-1 r exceeds the chi-square
 //      median of its rows, one down otherwise. With a correct R_s and P << R_s this rule walks
 //      at random, and outliers push it up: kept for comparison (docs/experiment.md).
