@@ -55,6 +55,7 @@ TEST_F(SunWindowTermTest, VerticalChannelIsCountedApartAndSplitsTheWalkByGravity
   opt.innovation_gate_chi2 = 0.0;
   opt.max_drift_deg_per_frame = 0.5;
   opt.vertical_max_drift_deg_per_frame = 0.5;
+  opt.vertical_drift_adaptation = VerticalDriftAdaptation::kPersistence;  // the tilt's walk steps
   ASSERT_TRUE(opt.split_drift_by_gravity);
   SunWindowTerm split;
   runStandingTiltError(this, &window_, opt, &split, T_k_b_true_, obs_b_, obs_k_);
@@ -91,6 +92,7 @@ TEST_F(SunWindowTermTest, ANoisySunBesideTheVerticalLeavesTheTiltWalkToTheVertic
   opt.innovation_gate_chi2 = 0.0;
   opt.max_drift_deg_per_frame = 0.01;  // ImageEstimatorFusion's cap of the sun's walks
   opt.vertical_max_drift_deg_per_frame = 0.5;
+  opt.vertical_drift_adaptation = VerticalDriftAdaptation::kPersistence;
   SunObservation sun = perfectObservation(SunMeasurementKind::kAzimuthOnly, 15.0 * kDeg);
   SunWindowTerm alone;
   runStandingTiltError(this, &window_, opt, &alone, T_k_b_true_, obs_b_, obs_k_);
@@ -106,6 +108,53 @@ TEST_F(SunWindowTermTest, ANoisySunBesideTheVerticalLeavesTheTiltWalkToTheVertic
   ASSERT_TRUE(sun_only.init(opt).isOk());
   for (std::uint64_t k = 1; k <= 41; k += 2) solveAt(&sun_only, k, sun);
   EXPECT_LE(sun_only.tiltDriftDegPerFrame(), opt.max_drift_deg_per_frame);
+}
+
+// The evidence rule for the tilt (kEvidence): a standing tilt error that the cue's answers show
+// widens the tilt part of P to it instead of stepping the walk, so q_tilt stays at its floor, the
+// heading part of P is left alone, and the error is corrected; without the evidence (the same
+// start, answers that agree with VO) nothing is widened.
+TEST_F(SunWindowTermTest, AStandingTiltTheCueEvidencesWidensTheTiltCovarianceOnly) {
+  SunFusionOptions opt = baseAttitudeOptions();
+  opt.initial_attitude_sigma_deg = 0.1;
+  opt.innovation_gate_chi2 = 0.0;
+  opt.vertical_drift_adaptation = VerticalDriftAdaptation::kEvidence;
+  SunWindowTerm term;
+  runStandingTiltError(this, &window_, opt, &term, T_k_b_true_, obs_b_, obs_k_);
+  EXPECT_EQ(term.verticalCounters().accepted, 21u);
+  EXPECT_GT(term.numInflations(), 0u);
+  EXPECT_EQ(term.tiltDriftDegPerFrame(), opt.min_drift_deg_per_frame);
+  EXPECT_EQ(term.headingDriftDegPerFrame(), opt.attitude_drift_deg_per_frame);
+  // World up is -y: the tilt part of P (x, z) covers the 2 deg roll, the heading part (y) has
+  // only its start and walk (0.1 deg and 0.01 deg/frame over 42 frames).
+  const Eigen::Matrix3d& P = term.attitudeCovariance();
+  EXPECT_GT(std::sqrt(P(0, 0) + P(2, 2)) / kDeg, 0.3);
+  EXPECT_LT(std::sqrt(P(1, 1)) / kDeg, 0.12);
+  // Each window starts from the same 2 deg, so this is one window's share (1.00 deg left,
+  // measured 2026-11-29).
+  const Eigen::Vector3d e =
+      logSO3(T_k_b_true_.linear().transpose() * window_.T_w_newest().linear().transpose());
+  EXPECT_LT(std::hypot(e.x(), e.z()) / kDeg, 1.5);
+
+  // No standing error (VO's attitude agrees with the answers): no evidence, no widening.
+  SunWindowTerm calm;
+  ASSERT_TRUE(calm.init(opt).isOk());
+  for (std::uint64_t k = 1; k <= 41; k += 2) {
+    window_.reset(Isometry3::Identity());
+    calm.attach(window_);
+    SunObservation up;
+    up.sun_w = Eigen::Vector3d(0.0, -1.0, 0.0);
+    up.measurement.sequence = k;
+    up.measurement.sigma = 0.01;
+    up.measurement.sun_c = T_k_b_true_.linear() * up.sun_w;
+    calm.addVertical(up);
+    const TimeNs t = static_cast<TimeNs>(k) * 100'000'000;
+    ASSERT_TRUE(window_.addFrame(k - 1, t - 100'000'000, obs_b_, Isometry3::Identity()).isOk());
+    ASSERT_TRUE(window_.addFrame(k, t, obs_k_, T_k_b_true_).isOk());
+    ASSERT_TRUE(window_.solve());
+  }
+  EXPECT_EQ(calm.verticalCounters().accepted, 21u);
+  EXPECT_EQ(calm.numInflations(), 0u);
 }
 
 // An "up" measured better in one direction than the other (the vertical cue: a level camera's

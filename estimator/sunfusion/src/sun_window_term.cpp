@@ -45,6 +45,8 @@ Status SunWindowTerm::init(const SunFusionOptions& options) {
   persistence_I_.setZero();
   sun_g_.setZero();
   sun_I_.setZero();
+  vertical_g_.setZero();
+  vertical_I_.setZero();
   vertical_in_sums_ = false;
   persistence_T_ = 0.0;
   persistence_bound_[0] = 0.0;
@@ -305,6 +307,7 @@ void SunWindowTerm::onSolved(backend::BundleWindow& window) {
   if (options_.drift_adaptation == DriftAdaptation::kEvidence) {
     persistence_g_ -= persistence_I_ * c_w;
   }
+  if (tiltByEvidence()) vertical_g_ -= vertical_I_ * c_w;
 }
 
 std::optional<Eigen::Vector3d> SunWindowTerm::takeStartLevelling(std::uint64_t sequence) {
@@ -388,8 +391,8 @@ void SunWindowTerm::adaptDrift(const Innovation& inn, const Eigen::Matrix3d& C_w
       break;
     }
     case DriftAdaptation::kEvidence:
-      accumulate(inn, C_w_b, &persistence_I_, &persistence_g_);
-      inflateToEvidence();
+      accumulate(inn, C_w_b, &persistence_I_, &persistence_g_, options_.evidence_forgetting);
+      persistence_T_ = inflateToEvidence(persistence_I_, persistence_g_);
       return;
     case DriftAdaptation::kPersistence: {
       // r ~ r0 + J delta_b and delta_b = C_b_w dtheta_w, so H = J C_b_w is the Jacobian wrt the
@@ -402,7 +405,8 @@ void SunWindowTerm::adaptDrift(const Innovation& inn, const Eigen::Matrix3d& C_w
       // steps the tilt's walk (split below), the sums forget on its answers only: a sun answer
       // between two of them would halve the memory of the cue's evidence the tilt's test reads.
       const bool forget = !(splitByGravity() && channel == 0 && vertical_in_sums_);
-      accumulate(inn, C_w_b, &persistence_I_, &persistence_g_, forget);
+      accumulate(inn, C_w_b, &persistence_I_, &persistence_g_,
+                 forget ? options_.persistence_forgetting : 1.0);
       std::size_t rank = 0;
       persistence_T_ = sunfusion::persistenceStatistic(persistence_I_, persistence_g_, &rank);
       step = rank > 0 && persistence_T_ > persistence_bound_[rank]
@@ -417,7 +421,14 @@ void SunWindowTerm::adaptDrift(const Innovation& inn, const Eigen::Matrix3d& C_w
         // azimuth-only 15 deg beside a 0.1 deg "up") neither dilutes the test, nor holds the walk
         // to the sun's cap, nor steps it a second time per frame on the cue's evidence. Without
         // vertical measurements the sun steps both walks on the same test, as one.
-        if (channel == 1) {
+        if (channel == 1 && tiltByEvidence()) {
+          // P's tilt part is made to cover the error the cue's answers evidence, and q_tilt
+          // stays at the floor: no walk to trail a steady drift.
+          vertical_in_sums_ = true;
+          accumulate(inn, C_w_b, &vertical_I_, &vertical_g_, options_.evidence_forgetting);
+          inflateToEvidence(vertical_I_, vertical_g_);
+          drift_deg_per_frame_ = options_.min_drift_deg_per_frame;
+        } else if (channel == 1) {
           vertical_in_sums_ = true;
           std::size_t tilt_rank = 0;
           const double T_tilt =
@@ -431,7 +442,7 @@ void SunWindowTerm::adaptDrift(const Innovation& inn, const Eigen::Matrix3d& C_w
           drift_deg_per_frame_ = clampDrift(drift_deg_per_frame_ * std::exp(step));
         }
         if (channel == 0) {
-          accumulate(inn, C_w_b, &sun_I_, &sun_g_);
+          accumulate(inn, C_w_b, &sun_I_, &sun_g_, options_.persistence_forgetting);
           std::size_t sun_rank = 0;
           const double T = sunfusion::persistenceStatistic(sun_I_, sun_g_, &sun_rank);
           const double step_h = sun_rank > 0 && T > persistence_bound_[sun_rank]
@@ -458,8 +469,13 @@ double SunWindowTerm::stepDrift(double q, double step, double cap) const {
   return std::max(std::min(next, upper), options_.min_drift_deg_per_frame);
 }
 
+bool SunWindowTerm::tiltByEvidence() const {
+  return splitByGravity() &&
+         options_.vertical_drift_adaptation == VerticalDriftAdaptation::kEvidence;
+}
+
 void SunWindowTerm::accumulate(const Innovation& inn, const Eigen::Matrix3d& C_w_b,
-                               Eigen::Matrix3d* I, Eigen::Vector3d* g, bool forget) const {
+                               Eigen::Matrix3d* I, Eigen::Vector3d* g, double lambda) const {
   // Fixed-size, with the rows past m zero (no heap allocation).
   const int m = inn.dof;
   Eigen::Matrix3d J = inn.J;
@@ -470,28 +486,24 @@ void SunWindowTerm::accumulate(const Innovation& inn, const Eigen::Matrix3d& C_w
   const double cap = options_.persistence_huber * std::sqrt(static_cast<double>(m));
   const double norm = r.norm();
   const double w = norm > cap ? cap / norm : 1.0;
-  const double lambda = !forget ? 1.0
-                        : options_.drift_adaptation == DriftAdaptation::kEvidence
-                            ? options_.evidence_forgetting
-                            : options_.persistence_forgetting;
   *g = lambda * *g + H.transpose() * (w * r);
   *I = lambda * *I + H.transpose() * H;
 }
 
-void SunWindowTerm::inflateToEvidence() {
+double SunWindowTerm::inflateToEvidence(const Eigen::Matrix3d& I, const Eigen::Vector3d& g) {
   // Along each well-informed direction v of I: e = v^T g / l estimates the error left, with
   // variance 1/l under noise alone. A significant e that P does not cover (v^T P v < e^2) widens P
   // along v to e^2, so that the following measurements may remove it; P never shrinks here.
   // Directions with less than a tenth of the strongest information are left alone: an
   // azimuth-only source barely informs some, and a few outliers would make e large there.
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(persistence_I_);
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(I);
   const double floor = 0.1 * std::max(eig.eigenvalues().maxCoeff(), 1e-300);
   double T = 0.0;
   for (int i = 0; i < 3; ++i) {
     const double l = eig.eigenvalues()(i);
     if (!(l > floor)) continue;
     const Eigen::Vector3d v = eig.eigenvectors().col(i);
-    const double e = v.dot(persistence_g_) / l;
+    const double e = v.dot(g) / l;
     T += e * e * l;
     const double deficit = e * e - v.dot(P_ * v);
     const double bound = options_.evidence_sigmas * options_.evidence_sigmas;
@@ -501,7 +513,7 @@ void SunWindowTerm::inflateToEvidence() {
       ++num_inflations_;
     }
   }
-  persistence_T_ = T;
+  return T;
 }
 
 bool SunWindowTerm::innovation(const ceres::CostFunction& cost, const Isometry3& T_k_b,

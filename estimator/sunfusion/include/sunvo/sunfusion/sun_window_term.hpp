@@ -130,6 +130,24 @@ inline std::span<const std::string_view> enumNames(DriftAdaptation) {
   return kNames;
 }
 
+// How the tilt's walk follows the vertical channel once it measures (persistence rule, split by
+// gravity; header comment).
+//  kPersistence: q_tilt is stepped on the tilt's persistence test, as the heading's on the sun's.
+//  kEvidence: q_tilt stays at min_drift_deg_per_frame, and the tilt part of P is widened to the
+//    error the cue's answers evidence (the evidence rule on sums of the vertical channel's answers
+//    alone, forgotten by evidence_forgetting and kept consistent with every correction; they lie
+//    in the plane normal to world_up). A walk stepped up and down trails a steady drift by a
+//    lag just below its test's threshold; under VO's steady tilt drift in the camera's axes that
+//    lag follows the camera, and its pitch part integrates into height, where VO's own error,
+//    fixed in the world, cancels as the route turns. Measured (docs/vertical.md, "The lag of the
+//    stepped walk"): kEvidence removes that cost on the error-model routes but holds the real
+//    cue's tilt worse on a rendered validation drive, so it is not the default.
+enum class VerticalDriftAdaptation { kPersistence, kEvidence };
+inline std::span<const std::string_view> enumNames(VerticalDriftAdaptation) {
+  static constexpr std::string_view kNames[] = {"persistence", "evidence"};
+  return kNames;
+}
+
 // What the vertical channel's answers of the first world_up_alignment_frames frames measure.
 //  kWorldUp: the world's up, which nobody measured (a world that is the first camera): their
 //    estimate becomes the world's up of the vertical channel, its gate and the walk's split.
@@ -197,6 +215,9 @@ struct SunFusionOptions {
   // either (measured: docs/vertical.md, "Two channels, two caps"). 0.05 = the default of
   // max_drift_deg_per_frame, the cap of the cue alone.
   double vertical_max_drift_deg_per_frame = 0.05;
+  // How the tilt's walk follows the vertical channel (above); evidence_sigmas,
+  // evidence_forgetting and evidence_correlation are its test's with kEvidence.
+  VerticalDriftAdaptation vertical_drift_adaptation = VerticalDriftAdaptation::kPersistence;
   double drift_adaptation_rate = 0.1;  // (0, 1]: log-step of q_theta per measurement (median rule)
   // Persistence rule: forgetting factor of the sums per measurement, (0, 1) (0.98: about the last
   // 50 measurements); false-alarm probability of the test on T, (0, 0.5]; log-steps up and down
@@ -254,6 +275,7 @@ struct SunFusionOptions {
     v("min_drift_deg_per_frame", s.min_drift_deg_per_frame);
     v("max_drift_deg_per_frame", s.max_drift_deg_per_frame);
     v("vertical_max_drift_deg_per_frame", s.vertical_max_drift_deg_per_frame);
+    v("vertical_drift_adaptation", s.vertical_drift_adaptation);
     v("drift_adaptation_rate", s.drift_adaptation_rate);
     v("persistence_forgetting", s.persistence_forgetting);
     v("persistence_false_alarm", s.persistence_false_alarm);
@@ -443,12 +465,15 @@ class SunWindowTerm {
   // One log-step of a walk q raised by a channel whose evidence may take it up to cap: a step up
   // stops at max(cap, q) (another channel's larger cap is not undone), a step down at the floor.
   double stepDrift(double q, double step, double cap) const;
-  // Adds an accepted measurement to forgotten sums I and g (world frame); forget = false adds it
-  // without forgetting the sums first.
+  // The tilt's walk follows the vertical channel by the evidence rule (kEvidence, split).
+  bool tiltByEvidence() const;
+  // Adds an accepted measurement to sums I and g (world frame) after forgetting them by lambda
+  // (1 = no forgetting).
   void accumulate(const Innovation& inn, const Eigen::Matrix3d& C_w_b, Eigen::Matrix3d* I,
-                  Eigen::Vector3d* g, bool forget = true) const;
-  // Evidence rule: widens P along directions where I^+ g stands out of its noise.
-  void inflateToEvidence();
+                  Eigen::Vector3d* g, double lambda) const;
+  // Evidence rule: widens P along directions where I^+ g stands out of its noise; returns the
+  // statistic over the informed directions.
+  double inflateToEvidence(const Eigen::Matrix3d& I, const Eigen::Vector3d& g);
 
   SunFusionOptions options_;
   std::unique_ptr<ceres::LossFunction> loss_;
@@ -477,6 +502,8 @@ class SunWindowTerm {
   Eigen::Matrix3d persistence_I_ = Eigen::Matrix3d::Zero();  // forgotten sum of H^T H
   Eigen::Vector3d sun_g_ = Eigen::Vector3d::Zero();  // the same sums, sun channel only (split)
   Eigen::Matrix3d sun_I_ = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d vertical_g_ = Eigen::Vector3d::Zero();  // the same, vertical channel only, kept
+  Eigen::Matrix3d vertical_I_ = Eigen::Matrix3d::Zero();  // consistent with the corrections
   bool vertical_in_sums_ = false;  // a vertical measurement has stepped the tilt's walk
   double persistence_T_ = 0.0;
   std::array<double, 4> persistence_bound_{};  // chi-square quantile by rank 1..3
