@@ -131,7 +131,7 @@ TEST_F(SunWindowTermTest, AStandingTiltTheCueEvidencesWidensTheTiltCovarianceOnl
   EXPECT_GT(std::sqrt(P(0, 0) + P(2, 2)) / kDeg, 0.3);
   EXPECT_LT(std::sqrt(P(1, 1)) / kDeg, 0.12);
   // Each window starts from the same 2 deg, so this is one window's share (1.00 deg left,
-  // measured 2026-11-29).
+  // measured 2026-11-28).
   const Eigen::Vector3d e =
       logSO3(T_k_b_true_.linear().transpose() * window_.T_w_newest().linear().transpose());
   EXPECT_LT(std::hypot(e.x(), e.z()) / kDeg, 1.5);
