@@ -45,11 +45,13 @@
 //      tilt's part of the test of all channels' sums (T_t = e_t^T C^+ e_t, e_t and C the tilt
 //      components of I^+ g and I^+; persistence_statistic.hpp), up to
 //      vertical_max_drift_deg_per_frame, and the sun's answers then add to those sums without
-//      forgetting them (they forget on the cue's answers). A precise "up" that evidences a tilt
-//      drift thus no longer widens the heading, which a 12-20 deg sun would then pull around; and
-//      a sun beside the "up" neither dilutes the tilt's test, nor holds its walk to an image
-//      estimator's low cap, nor steps it a second time per frame, nor shortens its memory
-//      (measured: docs/vertical.md). Without vertical measurements both are the same q_theta.
+//      forgetting them (they forget on the cue's answers); or, with vertical_drift_adaptation
+//      kEvidence, q_tilt stays at its floor and the cue's evidence widens P's tilt part. A
+//      precise "up" that evidences a tilt drift thus no longer widens the heading, which a
+//      12-20 deg sun would then pull around; and a sun beside the "up" neither dilutes the
+//      tilt's test, nor holds its walk to an image estimator's low cap, nor steps it a second
+//      time per frame, nor shortens its memory (measured: docs/vertical.md). Without vertical
+//      measurements both are the same q_theta.
 //    * kInnovationMedian: one log-step up when a measurement's r^T S^-1 r exceeds the chi-square
 //      median of its rows, one down otherwise. With a correct R_s and P << R_s this rule walks
 //      at random, and outliers push it up: kept for comparison (docs/experiment.md).
@@ -139,9 +141,10 @@ inline std::span<const std::string_view> enumNames(DriftAdaptation) {
 //    in the plane normal to world_up). A walk stepped up and down trails a steady drift by a
 //    lag just below its test's threshold; under VO's steady tilt drift in the camera's axes that
 //    lag follows the camera, and its pitch part integrates into height, where VO's own error,
-//    fixed in the world, cancels as the route turns. Measured (docs/vertical.md, "The lag of the
-//    stepped walk"): kEvidence removes that cost on the error-model routes but holds the real
-//    cue's tilt worse on a rendered validation drive, so it is not the default.
+//    fixed in the world, cancels as the route turns. Measured (docs/vertical.md, "The stepped
+//    walk's lag"): kEvidence removes that cost where it showed (00 seed 1) but costs another
+//    route its final drift and holds the real cue's tilt worse on a rendered validation drive,
+//    so it is not the default.
 enum class VerticalDriftAdaptation { kPersistence, kEvidence };
 inline std::span<const std::string_view> enumNames(VerticalDriftAdaptation) {
   static constexpr std::string_view kNames[] = {"persistence", "evidence"};
@@ -504,7 +507,7 @@ class SunWindowTerm {
   Eigen::Matrix3d sun_I_ = Eigen::Matrix3d::Zero();
   Eigen::Vector3d vertical_g_ = Eigen::Vector3d::Zero();  // the same, vertical channel only, kept
   Eigen::Matrix3d vertical_I_ = Eigen::Matrix3d::Zero();  // consistent with the corrections
-  bool vertical_in_sums_ = false;  // a vertical measurement has stepped the tilt's walk
+  bool vertical_in_sums_ = false;  // the vertical channel has taken the tilt's walk over
   double persistence_T_ = 0.0;
   std::array<double, 4> persistence_bound_{};  // chi-square quantile by rank 1..3
   std::optional<std::uint64_t> last_sequence_;
