@@ -144,6 +144,40 @@ TEST_F(SunWindowTermTest, AStandingTiltTheCueEvidencesWidensTheTiltCovarianceOnl
   EXPECT_EQ(calm.numInflations(), 0u);
 }
 
+// The likelihood rule for the tilt (kLikelihood): a standing 2 deg tilt error, which precise
+// answers show and no walk in the bank explains slowly, takes q_tilt to the top of its range
+// (0.05 deg/frame, measured) and leaves the heading's walk alone; answers that agree with VO keep
+// it low (0.0088 measured: the prior's start, 0.0045, over the noise scale at the bottom of its
+// range, where exact answers put it).
+TEST_F(SunWindowTermTest, TheCueInnovationsChooseTheTiltWalkFromTheBank) {
+  SunFusionOptions opt = baseAttitudeOptions();
+  opt.initial_attitude_sigma_deg = 0.1;
+  opt.innovation_gate_chi2 = 0.0;
+  opt.vertical_drift_adaptation = VerticalDriftAdaptation::kLikelihood;
+  SunWindowTerm term;
+  runStandingTiltError(this, &window_, opt, &term, T_k_b_true_, obs_b_, obs_k_);
+  EXPECT_EQ(term.verticalCounters().accepted, 21u);
+  EXPECT_GT(term.tiltDriftDegPerFrame(), 0.9 * opt.vertical_max_drift_deg_per_frame);
+  EXPECT_LE(term.tiltDriftDegPerFrame(), opt.vertical_max_drift_deg_per_frame);
+  EXPECT_EQ(term.headingDriftDegPerFrame(), opt.attitude_drift_deg_per_frame);
+
+  SunWindowTerm calm;
+  runStandingTiltError(this, &window_, opt, &calm, T_k_b_true_, obs_b_, obs_k_, std::nullopt, 0.0);
+  EXPECT_EQ(calm.verticalCounters().accepted, 21u);
+  EXPECT_LT(calm.tiltDriftDegPerFrame(), 0.02);
+  EXPECT_GE(calm.tiltDriftDegPerFrame(), opt.min_drift_deg_per_frame);
+
+  SunFusionOptions bad = opt;
+  bad.min_drift_deg_per_frame = 0.0;
+  EXPECT_FALSE(bad.validate().isOk());
+  bad = opt;
+  bad.likelihood_walks = 1;
+  EXPECT_FALSE(bad.validate().isOk());
+  bad = opt;
+  bad.likelihood_noise_min = 3.0;  // above the max
+  EXPECT_FALSE(bad.validate().isOk());
+}
+
 // An "up" measured better in one direction than the other (the vertical cue: a level camera's
 // roll from the segments' image angles, its pitch from their convergence) corrects each axis of
 // the tilt by its own sigma: with a 0.1 deg sigma along the camera's x axis (a turn about the

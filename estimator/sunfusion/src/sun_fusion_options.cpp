@@ -63,6 +63,27 @@ Status SunFusionOptions::validate() const {
   if (!(evidence_sigmas > 0.0 && evidence_sigmas <= 100.0)) {
     return invalidArgument("fusion.evidence_sigmas out of range (0, 100]");
   }
+  if (vertical_drift_adaptation == VerticalDriftAdaptation::kLikelihood) {
+    if (likelihood_walks < 2 || likelihood_walks > WalkBank::kMaxWalks) {
+      return invalidArgument("fusion.likelihood_walks out of range [2, 8]");
+    }
+    if (likelihood_noise_scales < 1 || likelihood_noise_scales > WalkBank::kMaxScales) {
+      return invalidArgument("fusion.likelihood_noise_scales out of range [1, 8]");
+    }
+    if (!(likelihood_noise_min > 0.0 && likelihood_noise_min <= likelihood_noise_max &&
+          likelihood_noise_max <= 100.0)) {
+      return invalidArgument(
+          "fusion.likelihood_noise_min / likelihood_noise_max: need 0 < min <= max <= 100");
+    }
+    if (!(likelihood_forgetting > 0.0 && likelihood_forgetting <= 1.0)) {
+      return invalidArgument("fusion.likelihood_forgetting out of range (0, 1]");
+    }
+    if (!(min_drift_deg_per_frame > 0.0)) {
+      return invalidArgument(
+          "fusion.min_drift_deg_per_frame must be > 0 with vertical_drift_adaptation likelihood "
+          "(the bank's slowest walk)");
+    }
+  }
   if (!(evidence_forgetting > 0.0 && evidence_forgetting < 1.0)) {
     return invalidArgument("fusion.evidence_forgetting out of range (0, 1)");
   }

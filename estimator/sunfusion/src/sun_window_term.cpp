@@ -63,6 +63,18 @@ Status SunWindowTerm::init(const SunFusionOptions& options) {
   last_nis_ = 0.0;
   num_inflations_ = 0;
   world_up_.reset(static_cast<std::uint64_t>(options.world_up_alignment_frames), options.world_up);
+  if (tiltByLikelihood()) {
+    WalkBankOptions bank;
+    bank.q_min_rad = options.min_drift_deg_per_frame * kDeg;
+    bank.q_max_rad = options.vertical_max_drift_deg_per_frame * kDeg;
+    bank.walks = options.likelihood_walks;
+    bank.noise_min = options.likelihood_noise_min;
+    bank.noise_max = options.likelihood_noise_max;
+    bank.noise_scales = options.likelihood_noise_scales;
+    bank.initial_sigma_rad = s0;
+    bank.forgetting = options.likelihood_forgetting;
+    SUNVO_RETURN_IF_ERROR(tilt_bank_.init(bank));
+  }
   alignment_gate_ = options.vertical_gate;
   if (options.levelsStartTilt()) {
     alignment_gate_.max_cosine_distance =
@@ -308,6 +320,7 @@ void SunWindowTerm::onSolved(backend::BundleWindow& window) {
     persistence_g_ -= persistence_I_ * c_w;
   }
   if (tiltByEvidence()) vertical_g_ -= vertical_I_ * c_w;
+  if (tiltByLikelihood()) tilt_bank_.shift(c_w);
 }
 
 std::optional<Eigen::Vector3d> SunWindowTerm::takeStartLevelling(std::uint64_t sequence) {
@@ -331,6 +344,7 @@ std::optional<Eigen::Vector3d> SunWindowTerm::takeStartLevelling(std::uint64_t s
   const double s2 = sigma * sigma;
   P_ = uu * P_ * uu + s2 * (Eigen::Matrix3d::Identity() - uu);
   P_tb_ = uu * P_tb_;
+  if (tiltByLikelihood()) tilt_bank_.shift(e);
   last_correction_ = {sequence, e, world_up_.used()};
   ++num_corrections_;
   return e;
@@ -351,6 +365,7 @@ void SunWindowTerm::propagate(double frames) {
     P_tb_ *= phi;
     P_bb_ = phi * phi * P_bb_ + (1.0 - phi * phi) * sigma_b * sigma_b;
   }
+  if (tiltByLikelihood()) tilt_bank_.propagate(frames, worldUp());
   const double q = drift_deg_per_frame_ * kDeg;
   if (!splitByGravity() || heading_drift_deg_per_frame_ == drift_deg_per_frame_) {
     P_ += Eigen::Matrix3d::Identity() * q * q * frames;
@@ -428,6 +443,18 @@ void SunWindowTerm::adaptDrift(const Innovation& inn, const Eigen::Matrix3d& C_w
           accumulate(inn, C_w_b, &vertical_I_, &vertical_g_, options_.evidence_forgetting);
           inflateToEvidence(vertical_I_, vertical_g_);
           drift_deg_per_frame_ = options_.min_drift_deg_per_frame;
+        } else if (channel == 1 && tiltByLikelihood()) {
+          // The walk the cue's innovations make most likely (walk_bank.hpp), an outlier's pull
+          // capped as in the sums.
+          vertical_in_sums_ = true;
+          const Eigen::Matrix3d H = inn.J * C_w_b.transpose();
+          Eigen::Vector3d r = inn.r;
+          const double cap = options_.persistence_huber * std::sqrt(static_cast<double>(inn.dof));
+          if (r.head(inn.dof).norm() > cap) r *= cap / r.head(inn.dof).norm();
+          tilt_bank_.update(H, r, inn.dof);
+          drift_deg_per_frame_ =
+              std::clamp(tilt_bank_.walk() / kDeg, options_.min_drift_deg_per_frame,
+                         options_.vertical_max_drift_deg_per_frame);
         } else if (channel == 1) {
           vertical_in_sums_ = true;
           std::size_t tilt_rank = 0;
@@ -472,6 +499,11 @@ double SunWindowTerm::stepDrift(double q, double step, double cap) const {
 bool SunWindowTerm::tiltByEvidence() const {
   return splitByGravity() &&
          options_.vertical_drift_adaptation == VerticalDriftAdaptation::kEvidence;
+}
+
+bool SunWindowTerm::tiltByLikelihood() const {
+  return splitByGravity() &&
+         options_.vertical_drift_adaptation == VerticalDriftAdaptation::kLikelihood;
 }
 
 void SunWindowTerm::accumulate(const Innovation& inn, const Eigen::Matrix3d& C_w_b,

@@ -132,7 +132,7 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"persistence", "median", "fixed", "evidence"}));
   sunvo::cli::addEnumOption(app, "--vertical-drift-rule", options.fusion.vertical_drift_adaptation,
                             "how the tilt's walk follows the \"up\" (persistence rule, split): "
-                            "persistence (default) or evidence (docs/vertical.md)");
+                            "likelihood (default), persistence or evidence (docs/vertical.md)");
   app.add_flag("!--no-split-drift", options.fusion.split_drift_by_gravity,
                "persistence rule: one random walk for all axes (before 2026-11-26), not one for "
                "the tilt and one for the heading");

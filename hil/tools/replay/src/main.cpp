@@ -96,9 +96,10 @@ int main(int argc, char** argv) {
   app.add_flag("--vertical-isotropic", isotropic_vertical,
                "the cue reports its worse direction's sigma for both (per_axis_sigma off, as "
                "before 2026-11-28)");
-  sunvo::cli::addEnumOption(app, "--vertical-drift-rule", options.fusion.vertical_drift_adaptation,
-                            "how the tilt's walk follows the cue: persistence (default) or "
-                            "evidence (docs/vertical.md)");
+  sunvo::cli::addEnumOption(
+      app, "--vertical-drift-rule", options.fusion.vertical_drift_adaptation,
+      "how the tilt's walk follows the cue: likelihood (default), persistence or "
+      "evidence (docs/vertical.md)");
   app.add_option("--world-up-alignment-frames", options.world_up_alignment_frames,
                  "the cue's answers of the first N frames measure the world's up (-1: 50 when the "
                  "world is the first camera, which nobody levelled; 0 in ENU)")

@@ -1,0 +1,83 @@
+#pragma once
+// The tilt's random walk chosen by the likelihood of the vertical cue's innovations over a small
+// bank of walks (multiple-model adaptive estimation; fusion.vertical_drift_adaptation likelihood).
+//
+// VO's tilt error e (world-frame rotation vector, normal to the world's up) is modelled as a
+// random walk, e_{k+1} = e_k + w_k, w_k ~ N(0, q^2 (I - u u^T)) per frame. Which q is right differs
+// tenfold between routes and cue sources (docs/vertical.md), and a walk stepped on a test trails
+// a steady drift. The cue's reported sigma is not exact either (on rendered drives 100 % of its
+// errors lie within 2 sigma, on real frames 36-60 %), and a filter's gain depends on the ratio of
+// the walk to the noise, so both are chosen together. Each member (j, i) of the bank is a Kalman
+// filter of e with its own walk q_j and noise scale s_i (both log-spaced over their ranges; the
+// answer's true std is s_i times the reported one) fed the same answers: an answer whose
+// whitened innovation at the current estimate is r = H e + n (H = d r / d e, m rows) has under
+// the member
+//   the prediction H x, the innovation covariance S = H P H^T + s_i^2 I,
+//   log-likelihood l <- lambda l - (nu^T S^-1 nu + log det S) / 2, nu = r - H x,
+//   and the update x += K nu, P -= K H P, K = P H^T S^-1.
+// The members track the error of the estimate the fusion keeps, so when the fusion corrects the
+// estimate by c_w every x becomes x - c_w (a known input: the members stay exact filters).
+// lambda < 1 forgets old answers, so the bank follows a drive whose drift changes. Weights
+// w proportional to exp(l) times a prior 1/q_j (not forgotten): the fusion starts near the slow
+// end (0.0045 deg/frame over the default ranges) and a faster walk must be earned, as the
+// persistence rule's walk sinks under noise alone. q and s are scales, averaged in their
+// logarithms. The fusion weighs each answer with its reported sigma, so the
+// walk it is given keeps the chosen member's ratio of walk to noise: walk() = exp(E[log q - log s])
+// (the same gain as the filter with the chosen walk and the true noise). A walk too slow leaves
+// innovations that persist, one too fast pays for its wide S, and a noise scale is told from the
+// walk by how the innovations correlate from answer to answer.
+// Fixed-size, no allocation.
+
+#include <Eigen/Core>
+#include <array>
+
+#include "sunvo/core/status.hpp"
+
+namespace sunvo::sunfusion {
+
+struct WalkBankOptions {
+  double q_min_rad = 0.0;          // rad/frame, > 0: the slowest walk
+  double q_max_rad = 0.0;          // rad/frame, >= q_min_rad: the fastest
+  int walks = 6;                   // [2, kMaxWalks]
+  double noise_min = 1.0;          // > 0: the smallest noise scale (true / reported std)
+  double noise_max = 1.0;          // >= noise_min
+  int noise_scales = 1;            // [1, kMaxScales]; 1 = noise_min (the reported sigma if 1)
+  double initial_sigma_rad = 0.0;  // rad, > 0: every member's start std per axis
+  double forgetting = 0.99;        // (0, 1]: of the log-likelihoods, per answer
+};
+
+class WalkBank {
+ public:
+  static constexpr int kMaxWalks = 8;
+  static constexpr int kMaxScales = 8;
+
+  Status init(const WalkBankOptions& options);
+  // frames have passed: each P grows by q_j^2 frames on the plane normal to up.
+  void propagate(double frames, const Eigen::Vector3d& up);
+  // One answer: m (1..3) whitened rows r (at the current estimate), H = d r / d e (world).
+  void update(const Eigen::Matrix3d& H, const Eigen::Vector3d& r, int m);
+  // The estimate was corrected by the world rotation vector c_w.
+  void shift(const Eigen::Vector3d& c_w);
+  // The walk for a fusion that weighs the answers by their reported sigma, exp(E[log q - log s]),
+  // rad per frame.
+  double walk() const;
+  double tiltWalk() const;    // exp(E[log q]), rad per frame
+  double noiseScale() const;  // exp(E[log s])
+  int members() const { return walks_ * scales_; }
+  double weight(int member) const;  // sums to 1 over the members
+
+ private:
+  static constexpr int kMax = kMaxWalks * kMaxScales;
+  double mean(bool walk_part, bool noise_part) const;
+  double logPosterior(int member) const;
+  int walks_ = 0;
+  int scales_ = 0;
+  double forgetting_ = 1.0;
+  std::array<double, kMaxWalks> log_q_{};
+  std::array<double, kMaxScales> log_s_{};
+  std::array<double, kMax> loglik_{};
+  std::array<Eigen::Vector3d, kMax> x_{};
+  std::array<Eigen::Matrix3d, kMax> P_{};
+};
+
+}  // namespace sunvo::sunfusion
