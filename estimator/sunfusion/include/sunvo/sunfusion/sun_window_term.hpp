@@ -152,8 +152,9 @@ inline std::span<const std::string_view> enumNames(DriftAdaptation) {
 //    vertical_max_drift_deg_per_frame] and noise scales of the cue's sigma, each a Kalman filter
 //    of the tilt fed the cue's answers and weighed by the likelihood of their innovations
 //    (walk_bank.hpp). Chosen on the validation sets (docs/vertical.md, "The tilt's walk from the
-//    likelihood of the cue's answers"): lower tilt RMS than kPersistence in every error-model
-//    cell and on three of the four rendered validation drives, without the lag's height cost.
+//    likelihood of the cue's answers"): lower tilt RMS than kPersistence in every validation
+//    cell of the error-model experiment and on three of the four rendered validation drives,
+//    without the lag's height cost.
 enum class VerticalDriftAdaptation { kPersistence, kEvidence, kLikelihood };
 inline std::span<const std::string_view> enumNames(VerticalDriftAdaptation) {
   static constexpr std::string_view kNames[] = {"persistence", "evidence", "likelihood"};
