@@ -232,10 +232,10 @@ struct SunFusionOptions {
   // evidence_forgetting and evidence_correlation are its test's with kEvidence.
   VerticalDriftAdaptation vertical_drift_adaptation = VerticalDriftAdaptation::kLikelihood;
   // kLikelihood (walk_bank.hpp): walks in the bank, [2, 8], log-spaced over
-  // [min_drift_deg_per_frame
-  // (> 0), vertical_max_drift_deg_per_frame]; the cue's noise scales (true / reported std), [1, 8],
-  // log-spaced over [likelihood_noise_min, likelihood_noise_max], both (0, 100]; forgetting of the
-  // log-likelihoods per answer of the cue, (0, 1] (0.99: about the last 100 answers).
+  // [min_drift_deg_per_frame (> 0), vertical_max_drift_deg_per_frame]; the cue's noise scales
+  // (true / reported std), [1, 8], log-spaced over [likelihood_noise_min, likelihood_noise_max],
+  // both (0, 100]; forgetting of the log-likelihoods per answer of the cue, (0, 1] (0.99: about
+  // the last 100 answers).
   int likelihood_walks = 6;
   int likelihood_noise_scales = 6;
   double likelihood_noise_min = 0.35;
