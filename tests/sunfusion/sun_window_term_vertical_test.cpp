@@ -50,6 +50,15 @@ void runStandingTiltError(SunWindowTermTest* t, backend::BundleWindow* window,
   }
 }
 
+// The options of the tilt-rule tests below: a confident start, no innovation gate.
+SunFusionOptions standingTiltOptions(VerticalDriftAdaptation rule) {
+  SunFusionOptions opt = baseAttitudeOptions();
+  opt.initial_attitude_sigma_deg = 0.1;
+  opt.innovation_gate_chi2 = 0.0;
+  opt.vertical_drift_adaptation = rule;
+  return opt;
+}
+
 TEST_F(SunWindowTermTest, VerticalChannelIsCountedApartAndSplitsTheWalkByGravity) {
   SunFusionOptions opt = baseAttitudeOptions();
   opt.initial_attitude_sigma_deg = 0.1;
@@ -116,10 +125,7 @@ TEST_F(SunWindowTermTest, ANoisySunBesideTheVerticalLeavesTheTiltWalkToTheVertic
 // heading part of P is left alone, and the error is corrected; without the evidence (the same
 // start, answers that agree with VO) nothing is widened.
 TEST_F(SunWindowTermTest, AStandingTiltTheCueEvidencesWidensTheTiltCovarianceOnly) {
-  SunFusionOptions opt = baseAttitudeOptions();
-  opt.initial_attitude_sigma_deg = 0.1;
-  opt.innovation_gate_chi2 = 0.0;
-  opt.vertical_drift_adaptation = VerticalDriftAdaptation::kEvidence;
+  const SunFusionOptions opt = standingTiltOptions(VerticalDriftAdaptation::kEvidence);
   SunWindowTerm term;
   runStandingTiltError(this, &window_, opt, &term, T_k_b_true_, obs_b_, obs_k_);
   EXPECT_EQ(term.verticalCounters().accepted, 21u);
@@ -150,10 +156,7 @@ TEST_F(SunWindowTermTest, AStandingTiltTheCueEvidencesWidensTheTiltCovarianceOnl
 // it low (0.0088 measured: the prior's start, 0.0045, over the noise scale at the bottom of its
 // range, where exact answers put it).
 TEST_F(SunWindowTermTest, TheCueInnovationsChooseTheTiltWalkFromTheBank) {
-  SunFusionOptions opt = baseAttitudeOptions();
-  opt.initial_attitude_sigma_deg = 0.1;
-  opt.innovation_gate_chi2 = 0.0;
-  opt.vertical_drift_adaptation = VerticalDriftAdaptation::kLikelihood;
+  const SunFusionOptions opt = standingTiltOptions(VerticalDriftAdaptation::kLikelihood);
   SunWindowTerm term;
   runStandingTiltError(this, &window_, opt, &term, T_k_b_true_, obs_b_, obs_k_);
   EXPECT_EQ(term.verticalCounters().accepted, 21u);
