@@ -320,6 +320,15 @@ TEST(Replay, AFirstCameraWorldAlignsItsUpFromTheCue) {
   ASSERT_TRUE(told) << told.status().toString();
   EXPECT_EQ(told->world_up_answers, 0);
   EXPECT_EQ(told->vertical_gate.accepted, told->vertical_stats.valid);
+  // The fusion's walks per frame; the tilt's from the bank (the default likelihood rule), within
+  // its range, with the cue's noise scale within its own.
+  ASSERT_EQ(told->walk_log.size(), told->T_w_c.size());
+  const auto& last = told->walk_log.back();
+  EXPECT_GE(last.tilt_deg, options.fusion.min_drift_deg_per_frame);
+  EXPECT_LE(last.tilt_deg, options.fusion.vertical_max_drift_deg_per_frame);
+  EXPECT_GT(last.bank_tilt_deg, 0.0);
+  EXPECT_GE(last.noise_scale, options.fusion.likelihood_noise_min);
+  EXPECT_LE(last.noise_scale, options.fusion.likelihood_noise_max);
 
   // Levelling the start needs a world whose up is known.
   options.fusion.world_up_alignment_use = sunfusion::WorldUpAlignmentUse::kStartTilt;

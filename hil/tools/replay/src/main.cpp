@@ -294,6 +294,23 @@ int main(int argc, char** argv) {
                    sc.roll_sigma_mrad * 0.180 / 3.141592653589793, sc.scale,
                    static_cast<unsigned long long>(sc.resets));
     }
+    if (!run->walk_log.empty()) {
+      // Per frame: OUT/attitude_walk_<run>.csv (the fusion's walks after each frame).
+      std::string csv =
+          "frame,tilt_walk_deg_per_frame,heading_walk_deg_per_frame,bank_tilt_walk_deg_per_frame,"
+          "cue_noise_scale\n";
+      char line[160];
+      for (std::size_t f = 0; f < run->walk_log.size(); ++f) {
+        const auto& w = run->walk_log[f];
+        std::snprintf(line, sizeof(line), "%zu,%.6f,%.6f,%.6f,%.4f\n", run->frame_index[f],
+                      w.tilt_deg, w.heading_deg, w.bank_tilt_deg, w.noise_scale);
+        csv += line;
+      }
+      const std::string path = out_dir + "/attitude_walk_" + fileSlug(run->name) + ".csv";
+      if (auto s = sunvo::files::writeWholeFile(path, csv); !s.isOk()) {
+        return sunvo::cli::fail(kProgram, s);
+      }
+    }
     if (run->sun_calls > 0) {
       std::fprintf(stderr, "  %-28s %d estimator calls, %.1f ms median, %.1f ms p90\n", "",
                    run->sun_calls, sunvo::metrics::percentile(run->sun_ms, 0.5),

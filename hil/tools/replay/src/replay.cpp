@@ -185,6 +185,15 @@ Expected<ReplayRun> replayDrive(const dataset::Dataset& data, const ReplayOption
       run.self_calibration_log.push_back(r->self_calibration);
     }
     if (options.record_features) run.features.push_back(vo.lastFeatures());
+    if (vo.options().use_sun || vo.options().vertical.enabled) {
+      const sunfusion::SunWindowTerm& term = vo.sunTerm();
+      ReplayRun::WalkSample w{term.tiltDriftDegPerFrame(), term.headingDriftDegPerFrame()};
+      if (term.tiltWalkFromLikelihood()) {
+        w.bank_tilt_deg = term.tiltBank().tiltWalk() * 180.0 / 3.141592653589793;
+        w.noise_scale = term.tiltBank().noiseScale();
+      }
+      run.walk_log.push_back(w);
+    }
   }
   run.gate = vo.sunCounters();
   run.vertical_gate = vo.verticalCounters();

@@ -410,6 +410,9 @@ class SunWindowTerm {
                             : drift_deg_per_frame_;
   }
   double tiltDriftDegPerFrame() const { return drift_deg_per_frame_; }
+  // kLikelihood: the bank the tilt's walk is chosen from (its walk and the cue's noise scale).
+  const WalkBank& tiltBank() const { return tilt_bank_; }
+  bool tiltWalkFromLikelihood() const { return tiltByLikelihood(); }
   double headingDriftDegPerFrame() const {
     return splitByGravity() ? heading_drift_deg_per_frame_ : drift_deg_per_frame_;
   }

@@ -94,6 +94,16 @@ struct ReplayRun {
   std::vector<double> sun_ms;                       // their wall times, ms
   selfcal::SelfCalibrationReport self_calibration;  // after the last frame (if enabled)
   std::vector<selfcal::SelfCalibrationReport> self_calibration_log;  // per frame (if enabled)
+  // The fusion's attitude walks after each frame (runs with a sun or the vertical cue): the
+  // tilt's and the heading's walk, deg/frame, and with the likelihood rule the bank's estimate of
+  // the tilt's own walk (deg/frame) and of the cue's noise scale (true / reported std); 0 without.
+  struct WalkSample {
+    double tilt_deg = 0.0;
+    double heading_deg = 0.0;
+    double bank_tilt_deg = 0.0;
+    double noise_scale = 0.0;
+  };
+  std::vector<WalkSample> walk_log;
   // Per processed frame, the front end's observations before any self-calibration correction
   // (only with ReplayOptions::record_features).
   std::vector<FrameFeatures> features;
