@@ -448,10 +448,7 @@ void SunWindowTerm::adaptDrift(const Innovation& inn, const Eigen::Matrix3d& C_w
           // capped as in the sums.
           vertical_in_sums_ = true;
           const Eigen::Matrix3d H = inn.J * C_w_b.transpose();
-          Eigen::Vector3d r = inn.r;
-          const double cap = options_.persistence_huber * std::sqrt(static_cast<double>(inn.dof));
-          if (r.head(inn.dof).norm() > cap) r *= cap / r.head(inn.dof).norm();
-          tilt_bank_.update(H, r, inn.dof);
+          tilt_bank_.update(H, huberWeight(inn) * inn.r, inn.dof);
           drift_deg_per_frame_ =
               std::clamp(tilt_bank_.walk() / kDeg, options_.min_drift_deg_per_frame,
                          options_.vertical_max_drift_deg_per_frame);
@@ -506,6 +503,12 @@ bool SunWindowTerm::tiltByLikelihood() const {
          options_.vertical_drift_adaptation == VerticalDriftAdaptation::kLikelihood;
 }
 
+double SunWindowTerm::huberWeight(const Innovation& inn) const {
+  const double cap = options_.persistence_huber * std::sqrt(static_cast<double>(inn.dof));
+  const double norm = inn.r.head(inn.dof).norm();
+  return norm > cap ? cap / norm : 1.0;
+}
+
 void SunWindowTerm::accumulate(const Innovation& inn, const Eigen::Matrix3d& C_w_b,
                                Eigen::Matrix3d* I, Eigen::Vector3d* g, double lambda) const {
   // Fixed-size, with the rows past m zero (no heap allocation).
@@ -515,10 +518,7 @@ void SunWindowTerm::accumulate(const Innovation& inn, const Eigen::Matrix3d& C_w
   J.bottomRows(3 - m).setZero();
   r.tail(3 - m).setZero();
   const Eigen::Matrix3d H = J * C_w_b.transpose();
-  const double cap = options_.persistence_huber * std::sqrt(static_cast<double>(m));
-  const double norm = r.norm();
-  const double w = norm > cap ? cap / norm : 1.0;
-  *g = lambda * *g + H.transpose() * (w * r);
+  *g = lambda * *g + H.transpose() * (huberWeight(inn) * r);
   *I = lambda * *I + H.transpose() * H;
 }
 

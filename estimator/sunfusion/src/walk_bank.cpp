@@ -96,10 +96,15 @@ double WalkBank::logPosterior(int k) const {
          (log_q_[static_cast<std::size_t>(k / scales_)] - log_q_[0]);
 }
 
-double WalkBank::weight(int member) const {
-  if (member < 0 || member >= members()) return 0.0;
+double WalkBank::maxLogPosterior() const {
   double top = -std::numeric_limits<double>::infinity();
   for (int k = 0; k < members(); ++k) top = std::max(top, logPosterior(k));
+  return top;
+}
+
+double WalkBank::weight(int member) const {
+  if (member < 0 || member >= members()) return 0.0;
+  const double top = maxLogPosterior();
   double sum = 0.0;
   for (int k = 0; k < members(); ++k) sum += std::exp(logPosterior(k) - top);
   return std::exp(logPosterior(member) - top) / sum;
@@ -107,8 +112,7 @@ double WalkBank::weight(int member) const {
 
 double WalkBank::mean(bool walk_part, bool noise_part) const {
   if (walks_ == 0) return 0.0;
-  double top = -std::numeric_limits<double>::infinity();
-  for (int k = 0; k < members(); ++k) top = std::max(top, logPosterior(k));
+  const double top = maxLogPosterior();
   double sum = 0.0;
   double log_value = 0.0;
   for (int k = 0; k < members(); ++k) {

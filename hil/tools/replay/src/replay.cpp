@@ -188,7 +188,7 @@ Expected<ReplayRun> replayDrive(const dataset::Dataset& data, const ReplayOption
     if (vo.options().use_sun || vo.options().vertical.enabled) {
       const sunfusion::SunWindowTerm& term = vo.sunTerm();
       ReplayRun::WalkSample w{term.tiltDriftDegPerFrame(), term.headingDriftDegPerFrame()};
-      if (term.tiltWalkFromLikelihood()) {
+      if (term.tiltByLikelihood()) {
         w.bank_tilt_deg = term.tiltBank().tiltWalk() * 180.0 / 3.141592653589793;
         w.noise_scale = term.tiltBank().noiseScale();
       }

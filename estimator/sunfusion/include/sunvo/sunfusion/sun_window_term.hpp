@@ -410,9 +410,10 @@ class SunWindowTerm {
                             : drift_deg_per_frame_;
   }
   double tiltDriftDegPerFrame() const { return drift_deg_per_frame_; }
-  // kLikelihood: the bank the tilt's walk is chosen from (its walk and the cue's noise scale).
+  // kLikelihood: the bank the tilt's walk is chosen from (its walk and the cue's noise scale),
+  // and whether it is in use (the likelihood rule with the walk split by gravity).
   const WalkBank& tiltBank() const { return tilt_bank_; }
-  bool tiltWalkFromLikelihood() const { return tiltByLikelihood(); }
+  bool tiltByLikelihood() const;
   double headingDriftDegPerFrame() const {
     return splitByGravity() ? heading_drift_deg_per_frame_ : drift_deg_per_frame_;
   }
@@ -498,7 +499,8 @@ class SunWindowTerm {
   double stepDrift(double q, double step, double cap) const;
   // The tilt's walk follows the vertical channel by the evidence rule (kEvidence, split).
   bool tiltByEvidence() const;
-  bool tiltByLikelihood() const;
+  // The weight that caps a whitened innovation's norm at persistence_huber sigmas per row.
+  double huberWeight(const Innovation& inn) const;
   // Adds an accepted measurement to sums I and g (world frame) after forgetting them by lambda
   // (1 = no forgetting).
   void accumulate(const Innovation& inn, const Eigen::Matrix3d& C_w_b, Eigen::Matrix3d* I,

@@ -70,6 +70,7 @@ class WalkBank {
   static constexpr int kMax = kMaxWalks * kMaxScales;
   double mean(bool walk_part, bool noise_part) const;
   double logPosterior(int member) const;
+  double maxLogPosterior() const;  // over the members, for weights without overflow
   int walks_ = 0;
   int scales_ = 0;
   double forgetting_ = 1.0;
