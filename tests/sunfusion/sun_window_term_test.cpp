@@ -106,7 +106,7 @@ TEST_F(SunWindowTermTest, BaseAttitudeModeRemovesTheObservableError) {
   // The unobservable part (2 deg * cos(50 deg) about the sun axis) is untouched.
   EXPECT_NEAR(rotationAngle(window_.T_w_b().linear()) / kDeg, 2.0 * 0.6428, 0.02);
   // The attitude uncertainty shrank across the sun axis only.
-  const Eigen::Matrix3d& P = term.attitudeCovariance();
+  const Eigen::Matrix3d P = term.attitudeCovariance();
   EXPECT_NEAR(sun_w_.dot(P * sun_w_), std::pow(3.0 * kDeg, 2), 1e-6);
   EXPECT_LT(P.trace(), 1.5 * std::pow(3.0 * kDeg, 2));
 }
@@ -300,7 +300,8 @@ TEST_F(SunWindowTermTest, BiasStateLeavesTheTiltToTheSun) {
 
 // A frame with a sun and an "up" measurement allocates nothing once the term and the window are
 // warm (issue 19: no heap allocation per sun frame): the term's costs are built by init() and only
-// get new numbers. Every form is checked: the paper's, the base correction, and the bias state.
+// get new numbers. Every form is checked: the paper's, the base correction, the sun's bias state,
+// the cue's, and both.
 TEST_F(SunWindowTermTest, SunFramesAllocateNothingOnceWarm) {
 #if !defined(SUNVO_HAVE_ALLOC_COUNTER)
   GTEST_SKIP() << "no allocation counter in this build";
@@ -313,9 +314,10 @@ TEST_F(SunWindowTermTest, SunFramesAllocateNothingOnceWarm) {
   up.measurement.sigma_strong = 0.2 * kDeg;  // measured better along x, as the cue reports it
   up.measurement.strong_axis_c = Eigen::Vector3d::UnitX();
   up.measurement.sun_c = T_k_b_true_.linear() * up.sun_w;
-  for (int form = 0; form < 3; ++form) {
+  for (int form = 0; form < 5; ++form) {
     SunFusionOptions opt = form == 0 ? cameraWorldOptions() : baseAttitudeOptions();
-    if (form == 2) opt.sun_bias_sigma_deg = 5.0;
+    if (form == 2 || form == 4) opt.sun_bias_sigma_deg = 5.0;
+    if (form >= 3) opt.vertical_bias_sigma_deg = 0.2;
     SunWindowTerm term;
     ASSERT_TRUE(term.init(opt).isOk());
     const auto frame = [&](std::uint64_t k) {
@@ -430,6 +432,9 @@ TEST(SunFusionOptionsTest, ValidationNamesTheBadKey) {
       {[](SunFusionOptions& o) { o.max_correction_deg = -1.0; }, "max_correction_deg"},
       {[](SunFusionOptions& o) { o.sun_bias_sigma_deg = 50.0; }, "sun_bias_sigma_deg"},
       {[](SunFusionOptions& o) { o.sun_bias_length_frames = 0.0; }, "sun_bias_length_frames"},
+      {[](SunFusionOptions& o) { o.vertical_bias_sigma_deg = 11.0; }, "vertical_bias_sigma_deg"},
+      {[](SunFusionOptions& o) { o.vertical_bias_length_frames = 0.5; },
+       "vertical_bias_length_frames"},
       {[](SunFusionOptions& o) { o.start_tilt_max_deg = 0.0; }, "start_tilt_max_deg"},
       {[](SunFusionOptions& o) { o.start_tilt_max_deg = 46.0; }, "start_tilt_max_deg"},
   };

@@ -1,8 +1,10 @@
-// Validation of SunFusionOptions (sun_window_term.hpp): each field against its documented range,
+// Validation of SunFusionOptions (sun_fusion_options.hpp): each field against its documented range,
 // the error naming the config key.
+#include "sunvo/sunfusion/sun_fusion_options.hpp"
+
 #include <cmath>
 
-#include "sunvo/sunfusion/sun_window_term.hpp"
+#include "sunvo/sunfusion/walk_bank.hpp"
 
 namespace sunvo::sunfusion {
 
@@ -98,6 +100,12 @@ Status SunFusionOptions::validate() const {
   }
   if (!(sun_bias_length_frames >= 1.0 && sun_bias_length_frames <= 1e6)) {
     return invalidArgument("fusion.sun_bias_length_frames out of range [1, 1e6]");
+  }
+  if (!(vertical_bias_sigma_deg >= 0.0 && vertical_bias_sigma_deg <= 10.0)) {
+    return invalidArgument("fusion.vertical_bias_sigma_deg out of range [0, 10]");
+  }
+  if (!(vertical_bias_length_frames >= 1.0 && vertical_bias_length_frames <= 1e7)) {
+    return invalidArgument("fusion.vertical_bias_length_frames out of range [1, 1e7]");
   }
   return Status::ok();
 }

@@ -1,10 +1,11 @@
 #include "sunvo/sunfusion/sun_window_term.hpp"
 
 #include <Eigen/Cholesky>
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <vector>
 
 #include "sunvo/core/geometry.hpp"
 #include "sunvo/sunfusion/persistence_statistic.hpp"
@@ -18,6 +19,8 @@ constexpr double kDeg = M_PI / 180.0;
 using RowsJacobian = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor, 3, 3>;
 using RowsSquare = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 3, 3>;
 using RowsVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 3, 1>;
+// A cost's Jacobian over the augmented state (3 to 6 columns).
+using ActiveJacobian = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor, 3, 6>;
 
 }  // namespace
 
@@ -32,11 +35,24 @@ Status SunWindowTerm::init(const SunFusionOptions& options) {
   last_decision_.reset();
   delta_ = {0.0, 0.0, 0.0};
   const double s0 = options.initial_attitude_sigma_deg * kDeg;
-  P_ = Eigen::Matrix3d::Identity() * s0 * s0;
+  Pa_.setZero();
+  P() = Eigen::Matrix3d::Identity() * s0 * s0;
+  num_active_ = 0;
+  for (int i = 0; i < 3; ++i) active_[static_cast<std::size_t>(num_active_++)] = i;
+  if (biasEnabled()) {
+    Pa_(kSunBias, kSunBias) = std::pow(options.sun_bias_sigma_deg * kDeg, 2);
+    active_[static_cast<std::size_t>(num_active_++)] = kSunBias;
+  }
+  if (upBiasEnabled()) {
+    Pa_.block<2, 2>(kUpBias, kUpBias) =
+        Eigen::Matrix2d::Identity() * std::pow(options.vertical_bias_sigma_deg * kDeg, 2);
+    active_[static_cast<std::size_t>(num_active_++)] = kUpBias;
+    active_[static_cast<std::size_t>(num_active_++)] = kUpBias + 1;
+  }
   bias_ = 0.0;
   bias_delta_ = 0.0;
-  P_bb_ = biasEnabled() ? std::pow(options.sun_bias_sigma_deg * kDeg, 2) : 0.0;
-  P_tb_.setZero();
+  up_bias_.setZero();
+  up_bias_delta_ = {0.0, 0.0};
   drift_deg_per_frame_ = options.drift_adaptation == DriftAdaptation::kEvidence
                              ? options.min_drift_deg_per_frame
                              : options.attitude_drift_deg_per_frame;
@@ -82,14 +98,14 @@ Status SunWindowTerm::init(const SunFusionOptions& options) {
                  1.0 - std::cos(options.start_tilt_max_deg * kDeg));
   }
   // Every cost a slot can need, in the form the options ask for (the only allocations).
-  const SunResidualForm form = !options.estimate_base_attitude ? SunResidualForm::kPaper
-                               : biasEnabled() ? SunResidualForm::kBaseCorrectionAndBias
-                                               : SunResidualForm::kBaseCorrection;
+  const SunResidualForm base =
+      !options.estimate_base_attitude ? SunResidualForm::kPaper : SunResidualForm::kBaseCorrection;
+  const SunResidualForm sun_form = biasEnabled() ? SunResidualForm::kBaseCorrectionAndBias : base;
+  const SunResidualForm up_form =
+      upBiasEnabled() ? SunResidualForm::kBaseCorrectionAndUpBias : base;
   for (std::size_t i = 0; i < kSlots; ++i) {
-    // The vertical channel (odd slots) has no bias state.
-    const SunResidualForm f = form == SunResidualForm::kBaseCorrectionAndBias && i % kChannels != 0
-                                  ? SunResidualForm::kBaseCorrection
-                                  : form;
+    // Even slots the sun's, odd ones the vertical channel's.
+    const SunResidualForm f = i % kChannels == 0 ? sun_form : up_form;
     CostSlot& c = costs_[i];
     c.direction = new SunDirectionResidual(Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitZ(), 1.0);
     c.direction_cost.reset(wrapSunResidual<SunDirectionResidual, 3>(c.direction, f));
@@ -98,9 +114,9 @@ Status SunWindowTerm::init(const SunFusionOptions& options) {
   }
   prior_ = new AttitudePriorResidual(Eigen::Matrix3d::Identity());
   prior_cost_.reset(new ceres::AutoDiffCostFunction<AttitudePriorResidual, 3, 3>(prior_));
-  bias_prior_ = new AttitudeBiasPriorResidual(Eigen::Matrix4d::Identity());
-  bias_prior_cost_.reset(
-      new ceres::AutoDiffCostFunction<AttitudeBiasPriorResidual, 4, 3, 1>(bias_prior_));
+  joint_prior_cost_.reset(num_active_ == 6   ? JointPriorResidual<6>::Create(&joint_prior_L_)
+                          : num_active_ == 5 ? JointPriorResidual<5>::Create(&joint_prior_L_)
+                                             : JointPriorResidual<4>::Create(&joint_prior_L_));
   return Status::ok();
 }
 
@@ -112,6 +128,7 @@ ceres::CostFunction* SunWindowTerm::setSunCost(std::size_t ring, const Eigen::Ve
     return c.azimuth_cost.get();
   }
   c.direction->set(sun_b, m.sun_c, m.sigma, bias_, m.sigma_strong, m.strong_axis_c);
+  c.direction->setUpBiasEstimate(up_bias_);
   return c.direction_cost.get();
 }
 
@@ -146,14 +163,18 @@ Status SunWindowTerm::onSolve(backend::BundleWindow& window) {
   last_sequence_ = newest;
   delta_ = {0.0, 0.0, 0.0};
   bias_delta_ = 0.0;
+  up_bias_delta_ = {0.0, 0.0};
   num_used_ = 0;
 
   // Prior of this solve's base correction delta_b = C_b_w dtheta_w: N(0, C_b_w P_theta C_w_b),
-  // jointly with the bias correction db ~ N(0, P_bb) when the bias is a state.
+  // jointly with the bias states' corrections where they are states.
   const Eigen::Matrix3d C_b_w = window.T_w_b().linear().transpose();
-  const Eigen::Matrix3d P_b = C_b_w * P_ * C_b_w.transpose();
-  const BasePrior prior{P_b, C_b_w * P_tb_, P_bb_};
-  const bool with_bias = biasEnabled();
+  BasePrior prior;
+  prior.P = activeCovariance(C_b_w);
+  prior.n = num_active_;
+  prior.sun_col = biasEnabled() ? 3 : -1;
+  prior.up_col = upBiasEnabled() ? 3 + (biasEnabled() ? 1 : 0) : -1;
+  const Eigen::Matrix3d P_b = prior.P.topLeftCorner<3, 3>();
   for (int i = kChannels; i < window.size() * kChannels; ++i) {
     const int s = i / kChannels, channel = i % kChannels;
     const std::size_t ring =
@@ -167,10 +188,15 @@ Status SunWindowTerm::onSolve(backend::BundleWindow& window) {
     const Eigen::Vector3d sun_w = channel == 0 ? p.obs.sun_w : worldUp();
     const Eigen::Vector3d sun_b = C_b_w * sun_w;
     bool cost_built = false;  // p.cost already holds this solve's residual
-    const bool bias_cost = with_bias && channel == 0;
+    // The cost's bias block, if its channel's bias is a state.
+    double* const bias_block = channel == 0 ? (biasEnabled() ? &bias_delta_ : nullptr)
+                                            : (upBiasEnabled() ? up_bias_delta_.data() : nullptr);
     if (!p.decided) {
       Eigen::Vector3d predicted_c = window.T_k_b(s).linear() * sun_b;
-      if (bias_cost) predicted_c = turnAboutCameraY(predicted_c, bias_);
+      if (bias_block != nullptr && channel == 0) predicted_c = turnAboutCameraY(predicted_c, bias_);
+      if (bias_block != nullptr && channel == 1) {
+        predicted_c = turnAboutCameraXZ(predicted_c, up_bias_.x(), up_bias_.y());
+      }
       const double up = sun_w.dot(worldUp());
       GateResult r = gateSunMeasurement(channel == 0 ? options_.gate : options_.vertical_gate,
                                         predicted_c, up, p.obs.measurement);
@@ -220,21 +246,25 @@ Status SunWindowTerm::onSolve(backend::BundleWindow& window) {
     // The base may have moved since the last solve (the window slid), so s_b is rebuilt each time.
     if (!cost_built) p.cost = setSunCost(ring, sun_b, p.obs.measurement);
     if (estimate) {
-      double* extra[] = {delta_.data(), &bias_delta_};
-      SUNVO_RETURN_IF_ERROR(window.addResidual(s, p.cost, loss_.get(),
-                                               std::span<double* const>(extra, bias_cost ? 2 : 1)));
+      double* extra[] = {delta_.data(), bias_block};
+      SUNVO_RETURN_IF_ERROR(window.addResidual(
+          s, p.cost, loss_.get(), std::span<double* const>(extra, bias_block ? 2 : 1)));
       p.consumed = true;
       used_in_solve_[static_cast<std::size_t>(num_used_++)] = static_cast<int>(ring);
     } else {
       SUNVO_RETURN_IF_ERROR(window.addPoseResidual(s, p.cost, loss_.get()));
     }
   }
-  if (estimate && num_used_ > 0 && with_bias) {
-    Eigen::Matrix4d P4;
-    P4 << P_b, prior.P_tb_b, prior.P_tb_b.transpose(), P_bb_;
-    bias_prior_->set(Eigen::LLT<Eigen::Matrix4d>(P4.inverse()).matrixU());
-    double* extra[] = {delta_.data(), &bias_delta_};
-    SUNVO_RETURN_IF_ERROR(window.addResidual(-1, bias_prior_cost_.get(), nullptr, extra));
+  if (estimate && num_used_ > 0 && prior.n > 3) {
+    // Square-root information of the joint prior over (delta_b, the bias corrections).
+    const ActiveMatrix info = prior.P.inverse();
+    joint_prior_L_.topLeftCorner(prior.n, prior.n) = Eigen::LLT<ActiveMatrix>(info).matrixU();
+    std::array<double*, 3> extra{delta_.data()};
+    std::size_t blocks = 1;
+    if (biasEnabled()) extra[blocks++] = &bias_delta_;
+    if (upBiasEnabled()) extra[blocks++] = up_bias_delta_.data();
+    SUNVO_RETURN_IF_ERROR(window.addResidual(-1, joint_prior_cost_.get(), nullptr,
+                                             std::span<double* const>(extra.data(), blocks)));
   } else if (estimate && num_used_ > 0) {
     // Square-root information of the prior: L^T L = P_b^-1.
     const Eigen::Matrix3d info = P_b.inverse();
@@ -248,9 +278,12 @@ Status SunWindowTerm::onSolve(backend::BundleWindow& window) {
 
 void SunWindowTerm::onSolved(backend::BundleWindow& window) {
   if (!options_.estimate_base_attitude || num_used_ == 0) return;
-  // Information of the sun residuals about (delta_b, db) at the solution (db: zero column
-  // without the bias state).
-  Eigen::Matrix4d info4 = Eigen::Matrix4d::Zero();
+  // Information of the sun residuals about the active state (delta_b, the bias corrections) at
+  // the solution; columns as in the solve's prior.
+  const int n = num_active_;
+  const int sun_col = 3, up_col = 3 + (biasEnabled() ? 1 : 0);
+  ActiveMatrix info = ActiveMatrix::Zero(n, n);
+  Eigen::Matrix3d info_t = Eigen::Matrix3d::Zero();  // about delta_b alone (no bias state)
   for (int i = 0; i < num_used_; ++i) {
     const Pending& p =
         pending_[static_cast<std::size_t>(used_in_solve_[static_cast<std::size_t>(i)])];
@@ -260,54 +293,61 @@ void SunWindowTerm::onSolved(backend::BundleWindow& window) {
     }
     if (slot < 0 || !p.cost) continue;
     Eigen::Matrix<double, 3, 3, Eigen::RowMajor> J_d;
-    Eigen::Vector3d J_b;
+    BiasJacobian J_b;
     Eigen::Vector3d r;
-    int m = 0;
-    if (!evaluateAt(*p.cost, window.T_k_b(slot), delta_.data(), bias_delta_, &r, &J_d, &J_b, &m)) {
+    int m = 0, cols = 0;
+    // The cost's bias block at this solve's correction.
+    const bool sun_cost = used_in_solve_[static_cast<std::size_t>(i)] % kChannels == 0;
+    const double* bias = sun_cost ? &bias_delta_ : up_bias_delta_.data();
+    if (!evaluateAt(*p.cost, window.T_k_b(slot), delta_.data(), bias, &r, &J_d, &J_b, &cols, &m)) {
       continue;
     }
-    const RowsJacobian J = J_d.topRows(m);
-    info4.topLeftCorner<3, 3>() += J.transpose() * J;
-    if (biasEnabled()) {
-      const RowsVector jb = J_b.head(m);
-      info4.topRightCorner<3, 1>() += J.transpose() * jb;
-      info4(3, 3) += jb.squaredNorm();
-    }
+    const RowsJacobian J_t = J_d.topRows(m);
+    info_t += J_t.transpose() * J_t;
+    if (n == 3) continue;
+    ActiveJacobian J = ActiveJacobian::Zero(m, n);
+    J.leftCols(3) = J_t;
+    if (cols > 0) J.middleCols(cols == 1 ? sun_col : up_col, cols) = J_b.topLeftCorner(m, cols);
+    info += J.transpose() * J;
   }
-  info4.bottomLeftCorner<1, 3>() = info4.topRightCorner<3, 1>().transpose();
   const Eigen::Vector3d delta_b(delta_[0], delta_[1], delta_[2]);
   const double db = bias_delta_;
+  const Eigen::Vector2d dc(up_bias_delta_[0], up_bias_delta_[1]);
   const int used = num_used_;
   delta_ = {0.0, 0.0, 0.0};
   bias_delta_ = 0.0;
+  up_bias_delta_ = {0.0, 0.0};
   num_used_ = 0;
-  if (!delta_b.allFinite() || !info4.allFinite() || !std::isfinite(db)) return;
+  if (!delta_b.allFinite() || !info.allFinite() || !info_t.allFinite() || !std::isfinite(db) ||
+      !dc.allFinite()) {
+    return;
+  }
   const Eigen::Matrix3d C_w_b = window.T_w_b().linear();
-  if (biasEnabled()) {
-    // The same update over (dtheta_w, b): T = diag(C_w_b, 1) takes the information to the world.
-    Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
+  if (n > 3) {
+    // The same update over the augmented state: T = diag(C_w_b, I) takes the information to the
+    // world.
+    ActiveMatrix T = ActiveMatrix::Identity(n, n);
     T.topLeftCorner<3, 3>() = C_w_b;
-    const Eigen::Matrix4d A4 = T * info4 * T.transpose();
-    Eigen::Matrix4d P4;
-    P4 << P_, P_tb_, P_tb_.transpose(), P_bb_;
-    const Eigen::Matrix4d M4 = (Eigen::Matrix4d::Identity() + A4 * P4).inverse() * A4;
-    Eigen::Matrix4d P4_new = P4 - P4 * M4 * P4;
-    P4_new = 0.5 * (P4_new + P4_new.transpose());
-    if (!P4_new.allFinite() || !(P4_new(3, 3) >= 0.0)) return;
-    P_ = P4_new.topLeftCorner<3, 3>();
-    P_tb_ = P4_new.topRightCorner<3, 1>();
-    P_bb_ = P4_new(3, 3);
+    const ActiveMatrix A = T * info * T.transpose();
+    const ActiveMatrix Pn = activeCovariance(Eigen::Matrix3d::Identity());
+    const ActiveMatrix M = (ActiveMatrix::Identity(n, n) + A * Pn).inverse() * A;
+    ActiveMatrix P_new = Pn - Pn * M * Pn;
+    P_new = 0.5 * (P_new + P_new.transpose());
+    if (!P_new.allFinite() || !(P_new.diagonal().bottomRows(n - 3).minCoeff() >= 0.0)) return;
+    setActiveCovariance(P_new);
     bias_ += db;
+    up_bias_ += dc;
   } else {
     // information about dtheta_w
-    const Eigen::Matrix3d A = C_w_b * info4.topLeftCorner<3, 3>() * C_w_b.transpose();
+    const Eigen::Matrix3d A = C_w_b * info_t * C_w_b.transpose();
     // P <- (P^-1 + A)^-1, written as P - P (I + A P)^-1 A P: no inverse of a singular A (an
     // azimuth-only measurement informs one or two axes only).
-    const Eigen::Matrix3d M = (Eigen::Matrix3d::Identity() + A * P_).inverse() * A;
-    Eigen::Matrix3d P_new = P_ - P_ * M * P_;
+    const Eigen::Matrix3d P_old = P();
+    const Eigen::Matrix3d M = (Eigen::Matrix3d::Identity() + A * P_old).inverse() * A;
+    Eigen::Matrix3d P_new = P_old - P_old * M * P_old;
     P_new = 0.5 * (P_new + P_new.transpose());
     if (!P_new.allFinite()) return;
-    P_ = P_new;
+    P() = P_new;
   }
   window.correctBaseAttitude(expSO3(delta_b));
   const Eigen::Vector3d c_w = C_w_b * delta_b;
@@ -342,8 +382,10 @@ std::optional<Eigen::Vector3d> SunWindowTerm::takeStartLevelling(std::uint64_t s
   const Eigen::Vector3d& u = options_.world_up;
   const Eigen::Matrix3d uu = u * u.transpose();
   const double s2 = sigma * sigma;
-  P_ = uu * P_ * uu + s2 * (Eigen::Matrix3d::Identity() - uu);
-  P_tb_ = uu * P_tb_;
+  P() = uu * P() * uu + s2 * (Eigen::Matrix3d::Identity() - uu);
+  const Eigen::Matrix<double, 3, 3> P_tbias = uu * Pa_.topRightCorner<3, 3>();
+  Pa_.topRightCorner<3, 3>() = P_tbias;
+  Pa_.bottomLeftCorner<3, 3>() = P_tbias.transpose();
   if (tiltByLikelihood()) tilt_bank_.shift(e);
   last_correction_ = {sequence, e, world_up_.used()};
   ++num_corrections_;
@@ -356,223 +398,118 @@ bool SunWindowTerm::splitByGravity() const {
 }
 
 void SunWindowTerm::propagate(double frames) {
-  if (biasEnabled()) {
-    // Gauss-Markov: the estimate and its covariance with the attitude decay, the variance relaxes
-    // to sigma_b^2.
-    const double phi = std::exp(-frames / options_.sun_bias_length_frames);
-    const double sigma_b = options_.sun_bias_sigma_deg * kDeg;
-    bias_ *= phi;
-    P_tb_ *= phi;
-    P_bb_ = phi * phi * P_bb_ + (1.0 - phi * phi) * sigma_b * sigma_b;
+  if (biasEnabled() || upBiasEnabled()) {
+    // Gauss-Markov: each bias estimate and its covariances decay by its phi, its variance relaxes
+    // to its sigma^2 (a bias that is not a state keeps zero rows).
+    const double phi_b = std::exp(-frames / options_.sun_bias_length_frames);
+    const double phi_c = std::exp(-frames / options_.vertical_bias_length_frames);
+    Eigen::Matrix<double, kAugmented, 1> phi;
+    phi << 1.0, 1.0, 1.0, phi_b, phi_c, phi_c;
+    bias_ *= phi_b;
+    up_bias_ *= phi_c;
+    Pa_ = phi.asDiagonal() * Pa_ * phi.asDiagonal();
+    if (biasEnabled()) {
+      const double sigma_b = options_.sun_bias_sigma_deg * kDeg;
+      Pa_(kSunBias, kSunBias) += (1.0 - phi_b * phi_b) * sigma_b * sigma_b;
+    }
+    if (upBiasEnabled()) {
+      const double sigma_c = options_.vertical_bias_sigma_deg * kDeg;
+      for (int i = kUpBias; i < kUpBias + 2; ++i)
+        Pa_(i, i) += (1.0 - phi_c * phi_c) * sigma_c * sigma_c;
+    }
   }
   if (tiltByLikelihood()) tilt_bank_.propagate(frames, worldUp());
   const double q = drift_deg_per_frame_ * kDeg;
   if (!splitByGravity() || heading_drift_deg_per_frame_ == drift_deg_per_frame_) {
-    P_ += Eigen::Matrix3d::Identity() * q * q * frames;
+    P() += Eigen::Matrix3d::Identity() * q * q * frames;
     return;
   }
   // Tilt (the plane normal to the world's up) and heading (about it) walk apart.
   const Eigen::Vector3d& u = worldUp();
   const double qh = heading_drift_deg_per_frame_ * kDeg;
   const Eigen::Matrix3d uu = u * u.transpose();
-  P_ += (q * q * (Eigen::Matrix3d::Identity() - uu) + qh * qh * uu) * frames;
+  P() += (q * q * (Eigen::Matrix3d::Identity() - uu) + qh * qh * uu) * frames;
 }
 
 bool SunWindowTerm::evaluateAt(const ceres::CostFunction& cost, const Isometry3& T_k_b,
-                               const double* delta_b, double db, Eigen::Vector3d* r,
+                               const double* delta_b, const double* bias, Eigen::Vector3d* r,
                                Eigen::Matrix<double, 3, 3, Eigen::RowMajor>* J_d,
-                               Eigen::Vector3d* J_bias, int* m) {
+                               BiasJacobian* J_bias, int* bias_cols, int* m) {
   const Eigen::Quaterniond q(T_k_b.linear());
   Eigen::Matrix<double, 3, 4, Eigen::RowMajor> J_q;
-  J_bias->setZero();
-  const double* params[] = {q.coeffs().data(), delta_b, &db};
-  double* jacobians[] = {J_q.data(), J_d->data(), J_bias->data()};
+  // The bias block's Jacobian, m x cols row-major; at most 3 x 2.
+  std::array<double, 6> J_b{};
+  const std::vector<std::int32_t>& sizes = cost.parameter_block_sizes();
+  *bias_cols = sizes.size() > 2 ? sizes[2] : 0;
+  const double* params[] = {q.coeffs().data(), delta_b, bias};
+  double* jacobians[] = {J_q.data(), J_d->data(), J_b.data()};
   *m = cost.num_residuals();
-  return cost.Evaluate(params, r->data(), jacobians) && r->head(*m).allFinite() &&
-         J_d->topRows(*m).allFinite() && J_bias->head(*m).allFinite();
-}
-
-void SunWindowTerm::adaptDrift(const Innovation& inn, const Eigen::Matrix3d& C_w_b, int channel) {
-  const int m = inn.dof;
-  double step = 0.0;
-  switch (options_.drift_adaptation) {
-    case DriftAdaptation::kFixed:
-      return;
-    case DriftAdaptation::kInnovationMedian: {
-      // With a consistent filter the NIS is chi-square with m dof and exceeds its median half of
-      // the time: a stochastic approximation of the median, one step per measurement.
-      const double median = m <= 1 ? 0.455 : (m == 2 ? 1.386 : 2.366);
-      step = inn.nis > median ? options_.drift_adaptation_rate : -options_.drift_adaptation_rate;
-      break;
-    }
-    case DriftAdaptation::kEvidence:
-      accumulate(inn, C_w_b, &persistence_I_, &persistence_g_, options_.evidence_forgetting);
-      persistence_T_ = inflateToEvidence(persistence_I_, persistence_g_);
-      return;
-    case DriftAdaptation::kPersistence: {
-      // r ~ r0 + J delta_b and delta_b = C_b_w dtheta_w, so H = J C_b_w is the Jacobian wrt the
-      // world-frame attitude error. If dtheta_w stayed constant while the filter ignores it, the
-      // whitened innovations r_i ~ N(H_i dtheta_w, I) and the least-squares estimate from all of
-      // them, I^+ g with g = sum H_i^T r_i and I = sum H_i^T H_i, has the chi-square statistic
-      // T = g^T I^+ g with rank(I) dof when dtheta_w = 0 (noise only). The sums forget by
-      // persistence_forgetting per measurement, so T weighs the recent drift; a Huber weight
-      // caps an outlier's pull at persistence_huber sigmas per row. Once the vertical channel
-      // steps the tilt's walk (split below), the sums forget on its answers only: a sun answer
-      // between two of them would halve the memory of the cue's evidence the tilt's test reads.
-      const bool forget = !(splitByGravity() && channel == 0 && vertical_in_sums_);
-      accumulate(inn, C_w_b, &persistence_I_, &persistence_g_,
-                 forget ? options_.persistence_forgetting : 1.0);
-      std::size_t rank = 0;
-      persistence_T_ = sunfusion::persistenceStatistic(persistence_I_, persistence_g_, &rank);
-      step = rank > 0 && persistence_T_ > persistence_bound_[rank]
-                 ? options_.persistence_step_up
-                 : -options_.persistence_step_down;
-      if (splitByGravity()) {
-        // Each walk steps with the channel that measures it. The heading's on the sun's
-        // measurements, from sums of the sun's alone: an "up" never sees the heading. The tilt's,
-        // once a vertical measurement is in the sums, on the vertical channel's, up to that
-        // channel's cap, on the tilt's part of the test of all channels' sums
-        // (tiltPersistenceStatistic): a sun beside it that informs the tilt little (an
-        // azimuth-only 15 deg beside a 0.1 deg "up") neither dilutes the test, nor holds the walk
-        // to the sun's cap, nor steps it a second time per frame on the cue's evidence. Without
-        // vertical measurements the sun steps both walks on the same test, as one.
-        if (channel == 1 && tiltByEvidence()) {
-          // P's tilt part is made to cover the error the cue's answers evidence, and q_tilt
-          // stays at the floor: no walk to trail a steady drift.
-          vertical_in_sums_ = true;
-          accumulate(inn, C_w_b, &vertical_I_, &vertical_g_, options_.evidence_forgetting);
-          inflateToEvidence(vertical_I_, vertical_g_);
-          drift_deg_per_frame_ = options_.min_drift_deg_per_frame;
-        } else if (channel == 1 && tiltByLikelihood()) {
-          // The walk the cue's innovations make most likely (walk_bank.hpp), an outlier's pull
-          // capped as in the sums.
-          vertical_in_sums_ = true;
-          const Eigen::Matrix3d H = inn.J * C_w_b.transpose();
-          tilt_bank_.update(H, huberWeight(inn) * inn.r, inn.dof);
-          drift_deg_per_frame_ =
-              std::clamp(tilt_bank_.walk() / kDeg, options_.min_drift_deg_per_frame,
-                         options_.vertical_max_drift_deg_per_frame);
-        } else if (channel == 1) {
-          vertical_in_sums_ = true;
-          std::size_t tilt_rank = 0;
-          const double T_tilt =
-              tiltPersistenceStatistic(persistence_I_, persistence_g_, worldUp(), &tilt_rank);
-          const double step_t = tilt_rank > 0 && T_tilt > persistence_bound_[tilt_rank]
-                                    ? options_.persistence_step_up
-                                    : -options_.persistence_step_down;
-          drift_deg_per_frame_ =
-              stepDrift(drift_deg_per_frame_, step_t, options_.vertical_max_drift_deg_per_frame);
-        } else if (!vertical_in_sums_) {
-          drift_deg_per_frame_ = clampDrift(drift_deg_per_frame_ * std::exp(step));
-        }
-        if (channel == 0) {
-          accumulate(inn, C_w_b, &sun_I_, &sun_g_, options_.persistence_forgetting);
-          std::size_t sun_rank = 0;
-          const double T = sunfusion::persistenceStatistic(sun_I_, sun_g_, &sun_rank);
-          const double step_h = sun_rank > 0 && T > persistence_bound_[sun_rank]
-                                    ? options_.persistence_step_up
-                                    : -options_.persistence_step_down;
-          heading_drift_deg_per_frame_ =
-              clampDrift(heading_drift_deg_per_frame_ * std::exp(step_h));
-        }
-        return;
-      }
-      break;
-    }
+  if (!cost.Evaluate(params, r->data(), jacobians)) return false;
+  J_bias->setZero();
+  for (int i = 0; i < *m; ++i) {
+    for (int j = 0; j < *bias_cols; ++j)
+      (*J_bias)(i, j) = J_b[static_cast<std::size_t>(i * *bias_cols + j)];
   }
-  drift_deg_per_frame_ = clampDrift(drift_deg_per_frame_ * std::exp(step));
-}
-
-double SunWindowTerm::clampDrift(double q) const {
-  return std::clamp(q, options_.min_drift_deg_per_frame, options_.max_drift_deg_per_frame);
-}
-
-double SunWindowTerm::stepDrift(double q, double step, double cap) const {
-  const double next = q * std::exp(step);
-  const double upper = step > 0.0 ? std::max(cap, q) : next;
-  return std::max(std::min(next, upper), options_.min_drift_deg_per_frame);
-}
-
-bool SunWindowTerm::tiltByEvidence() const {
-  return splitByGravity() &&
-         options_.vertical_drift_adaptation == VerticalDriftAdaptation::kEvidence;
-}
-
-bool SunWindowTerm::tiltByLikelihood() const {
-  return splitByGravity() &&
-         options_.vertical_drift_adaptation == VerticalDriftAdaptation::kLikelihood;
-}
-
-double SunWindowTerm::huberWeight(const Innovation& inn) const {
-  const double cap = options_.persistence_huber * std::sqrt(static_cast<double>(inn.dof));
-  const double norm = inn.r.head(inn.dof).norm();
-  return norm > cap ? cap / norm : 1.0;
-}
-
-void SunWindowTerm::accumulate(const Innovation& inn, const Eigen::Matrix3d& C_w_b,
-                               Eigen::Matrix3d* I, Eigen::Vector3d* g, double lambda) const {
-  // Fixed-size, with the rows past m zero (no heap allocation).
-  const int m = inn.dof;
-  Eigen::Matrix3d J = inn.J;
-  Eigen::Vector3d r = inn.r;
-  J.bottomRows(3 - m).setZero();
-  r.tail(3 - m).setZero();
-  const Eigen::Matrix3d H = J * C_w_b.transpose();
-  *g = lambda * *g + H.transpose() * (huberWeight(inn) * r);
-  *I = lambda * *I + H.transpose() * H;
-}
-
-double SunWindowTerm::inflateToEvidence(const Eigen::Matrix3d& I, const Eigen::Vector3d& g) {
-  // Along each well-informed direction v of I: e = v^T g / l estimates the error left, with
-  // variance 1/l under noise alone. A significant e that P does not cover (v^T P v < e^2) widens P
-  // along v to e^2, so that the following measurements may remove it; P never shrinks here.
-  // Directions with less than a tenth of the strongest information are left alone: an
-  // azimuth-only source barely informs some, and a few outliers would make e large there.
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(I);
-  const double floor = 0.1 * std::max(eig.eigenvalues().maxCoeff(), 1e-300);
-  double T = 0.0;
-  for (int i = 0; i < 3; ++i) {
-    const double l = eig.eigenvalues()(i);
-    if (!(l > floor)) continue;
-    const Eigen::Vector3d v = eig.eigenvectors().col(i);
-    const double e = v.dot(g) / l;
-    T += e * e * l;
-    const double deficit = e * e - v.dot(P_ * v);
-    const double bound = options_.evidence_sigmas * options_.evidence_sigmas;
-    if (e * e * l > bound * options_.evidence_correlation && deficit > 0.0 &&
-        std::isfinite(deficit)) {
-      P_ += deficit * v * v.transpose();
-      ++num_inflations_;
-    }
-  }
-  return T;
+  return r->head(*m).allFinite() && J_d->topRows(*m).allFinite() && J_bias->allFinite();
 }
 
 bool SunWindowTerm::innovation(const ceres::CostFunction& cost, const Isometry3& T_k_b,
-                               const BasePrior& prior, Innovation* out) {
+                               const BasePrior& prior, Innovation* out) const {
   const double zero[3] = {0.0, 0.0, 0.0};
-  int n = 0;
-  if (!evaluateAt(cost, T_k_b, zero, 0.0, &out->r, &out->J, &out->J_bias, &n) || n <= 0) {
+  int n = 0, cols = 0;
+  BiasJacobian J_b;
+  if (!evaluateAt(cost, T_k_b, zero, zero, &out->r, &out->J, &J_b, &cols, &n) || n <= 0) {
     return false;
   }
   out->dof = n;
   const RowsJacobian J = out->J.topRows(n);
-  RowsSquare S = J * prior.P_b * J.transpose() + RowsSquare::Identity(n, n);
   const RowsVector rn = out->r.head(n);
-  if (prior.P_bb > 0.0) {
-    // S += J P_tb jb^T + jb P_tb^T J^T + P_bb jb jb^T: the bias's share of the innovation.
-    const RowsVector jb = out->J_bias.head(n);
-    const RowsVector Jp = J * prior.P_tb_b;
-    S += Jp * jb.transpose() + jb * Jp.transpose() + prior.P_bb * jb * jb.transpose();
+  if (prior.n > 3) {
+    // Over the active state: S = J_a P J_a^T + I, the bias states' share included; the predicted
+    // correction of delta_b is the top of P J_a^T S^-1 r.
+    ActiveJacobian J_a = ActiveJacobian::Zero(n, prior.n);
+    J_a.leftCols(3) = J;
+    if (cols > 0) {
+      J_a.middleCols(cols == 1 ? prior.sun_col : prior.up_col, cols) = J_b.topLeftCorner(n, cols);
+    }
+    const RowsSquare S = J_a * prior.P * J_a.transpose() + RowsSquare::Identity(n, n);
     const RowsVector Sinv_r = S.ldlt().solve(rn);
     out->nis = rn.dot(Sinv_r);
-    out->move_b = (prior.P_b * J.transpose() + prior.P_tb_b * jb.transpose()) * Sinv_r;
+    out->move_b = (prior.P * J_a.transpose() * Sinv_r).head<3>();
   } else {
+    const Eigen::Matrix3d P_b = prior.P.topLeftCorner<3, 3>();
+    const RowsSquare S = J * P_b * J.transpose() + RowsSquare::Identity(n, n);
     const RowsVector Sinv_r = S.ldlt().solve(rn);
     out->nis = rn.dot(Sinv_r);
-    out->move_b = prior.P_b * J.transpose() * Sinv_r;
+    out->move_b = P_b * J.transpose() * Sinv_r;
   }
   return std::isfinite(out->nis) && out->move_b.allFinite();
+}
+
+SunWindowTerm::ActiveMatrix SunWindowTerm::activeCovariance(const Eigen::Matrix3d& C) const {
+  ActiveMatrix P(num_active_, num_active_);
+  for (int i = 0; i < num_active_; ++i) {
+    for (int j = 0; j < num_active_; ++j) {
+      P(i, j) = Pa_(active_[static_cast<std::size_t>(i)], active_[static_cast<std::size_t>(j)]);
+    }
+  }
+  // The attitude's rows and columns in C's frame.
+  const Eigen::Matrix3d P_t = Pa_.topLeftCorner<3, 3>();
+  P.topLeftCorner<3, 3>() = C * P_t * C.transpose();
+  const int b = num_active_ - 3;
+  if (b > 0) {
+    P.topRightCorner(3, b) = C * P.topRightCorner(3, b);
+    P.bottomLeftCorner(b, 3) = P.topRightCorner(3, b).transpose();
+  }
+  return P;
+}
+
+void SunWindowTerm::setActiveCovariance(const ActiveMatrix& P) {
+  for (int i = 0; i < num_active_; ++i) {
+    for (int j = 0; j < num_active_; ++j) {
+      Pa_(active_[static_cast<std::size_t>(i)], active_[static_cast<std::size_t>(j)]) = P(i, j);
+    }
+  }
 }
 
 }  // namespace sunvo::sunfusion

@@ -83,7 +83,7 @@ PoseRecord EstimatorStage::poseOf(const pipeline::FrameResult& r, const runtime:
   pose.ransac_inliers = r.vo.ransac_inliers;
   pose.reset_counter = reset_counter_;
   if (odometry_.options().use_sun) {
-    const Eigen::Matrix3d& P_w = odometry_.attitudeCovariance();
+    const Eigen::Matrix3d P_w = odometry_.attitudeCovariance();
     const double upper[6] = {P_w(0, 0), P_w(0, 1), P_w(0, 2), P_w(1, 1), P_w(1, 2), P_w(2, 2)};
     for (int i = 0; i < 6; ++i) pose.cov_theta_w[i] = upper[i];
     pose.cov_theta_valid = P_w.allFinite();

@@ -295,15 +295,17 @@ int main(int argc, char** argv) {
                    static_cast<unsigned long long>(sc.resets));
     }
     if (!run->walk_log.empty()) {
-      // Per frame: OUT/attitude_walk_<run>.csv (the fusion's walks after each frame).
+      // Per frame: OUT/attitude_walk_<run>.csv (the fusion's walks and the cue's bias state after
+      // each frame).
       std::string csv =
           "frame,tilt_walk_deg_per_frame,heading_walk_deg_per_frame,bank_tilt_walk_deg_per_frame,"
-          "cue_noise_scale\n";
-      char line[160];
+          "cue_noise_scale,up_bias_x_deg,up_bias_z_deg\n";
+      char line[200];
       for (std::size_t f = 0; f < run->walk_log.size(); ++f) {
         const auto& w = run->walk_log[f];
-        std::snprintf(line, sizeof(line), "%zu,%.6f,%.6f,%.6f,%.4f\n", run->frame_index[f],
-                      w.tilt_deg, w.heading_deg, w.bank_tilt_deg, w.noise_scale);
+        std::snprintf(line, sizeof(line), "%zu,%.6f,%.6f,%.6f,%.4f,%.4f,%.4f\n",
+                      run->frame_index[f], w.tilt_deg, w.heading_deg, w.bank_tilt_deg,
+                      w.noise_scale, w.up_bias_x_deg, w.up_bias_z_deg);
         csv += line;
       }
       const std::string path = out_dir + "/attitude_walk_" + fileSlug(run->name) + ".csv";

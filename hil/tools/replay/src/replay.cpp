@@ -192,6 +192,8 @@ Expected<ReplayRun> replayDrive(const dataset::Dataset& data, const ReplayOption
         w.bank_tilt_deg = term.tiltBank().tiltWalk() * 180.0 / 3.141592653589793;
         w.noise_scale = term.tiltBank().noiseScale();
       }
+      w.up_bias_x_deg = term.upBias().x() * 180.0 / 3.141592653589793;
+      w.up_bias_z_deg = term.upBias().y() * 180.0 / 3.141592653589793;
       run.walk_log.push_back(w);
     }
   }

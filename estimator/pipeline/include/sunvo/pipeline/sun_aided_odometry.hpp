@@ -118,7 +118,7 @@ class SunAidedOdometry {
   const Isometry3& T_w_c() const { return T_w_c_; }
   // Sun bookkeeping: what the gate decided, the world-attitude covariance (rad^2, world frame).
   const sunfusion::GateCounters& sunCounters() const { return sun_term_.counters(); }
-  const Eigen::Matrix3d& attitudeCovariance() const { return sun_term_.attitudeCovariance(); }
+  Eigen::Matrix3d attitudeCovariance() const { return sun_term_.attitudeCovariance(); }
   const sunfusion::SunWindowTerm& sunTerm() const { return sun_term_; }
   // The world's up: fusion.world_up, or its estimate from the first frames' "up" answers when
   // fusion.world_up_alignment_frames > 0 (sun_window_term.hpp).

@@ -53,9 +53,28 @@ Eigen::Matrix<T, 3, 1> turnAboutCameraY(const Eigen::Matrix<T, 3, 1>& s, const T
   return {c * s.x() + n * s.z(), s.y(), -n * s.x() + c * s.z()};
 }
 
+// The vertical cue's error that stays alike over a drive (SunFusionOptions::
+// vertical_bias_sigma_deg) is a small turn of the measured "up" about the camera's x axis (pitch)
+// and z axis (roll) by b = (b_x, b_z): the measurement is predicted as Exp((b_x, 0, b_z)) s_hat_k.
+// A turn about y does not move an up along y (a level camera's) and is not a state.
+template <typename T>
+Eigen::Matrix<T, 3, 1> turnAboutCameraXZ(const Eigen::Matrix<T, 3, 1>& s, const T& b_x,
+                                         const T& b_z) {
+  const T angle_axis[3] = {b_x, T(0.0), b_z};
+  Eigen::Matrix<T, 3, 1> turned;
+  ceres::AngleAxisRotatePoint(angle_axis, s.data(), turned.data());
+  return turned;
+}
+
 // Which blocks a sun residual acts on, after q_k_b (4): none (the paper's form), the base
-// correction delta (3), or delta and the azimuth bias's correction db (1).
-enum class SunResidualForm { kPaper, kBaseCorrection, kBaseCorrectionAndBias };
+// correction delta (3), delta and the azimuth bias's correction db (1), or delta and the up
+// bias's correction (2: about camera x and z; SunDirectionResidual only).
+enum class SunResidualForm {
+  kPaper,
+  kBaseCorrection,
+  kBaseCorrectionAndBias,
+  kBaseCorrectionAndUpBias
+};
 
 // The cost function of a sun residual functor in a form; takes ownership of r. The caller may
 // keep r and change its numbers with set() between solves (the window term reuses its costs so
@@ -67,6 +86,15 @@ ceres::CostFunction* wrapSunResidual(Residual* r, SunResidualForm form) {
       return new ceres::AutoDiffCostFunction<Residual, kRows, 4>(r);
     case SunResidualForm::kBaseCorrection:
       return new ceres::AutoDiffCostFunction<Residual, kRows, 4, 3>(r);
+    case SunResidualForm::kBaseCorrectionAndUpBias:
+      // An "up" is a 3-D direction: the azimuth-only residual has no up bias and takes the base
+      // correction only.
+      if constexpr (requires { r->useUpBias(); }) {
+        r->useUpBias();
+        return new ceres::AutoDiffCostFunction<Residual, kRows, 4, 3, 2>(r);
+      } else {
+        return new ceres::AutoDiffCostFunction<Residual, kRows, 4, 3>(r);
+      }
     case SunResidualForm::kBaseCorrectionAndBias:
       break;
   }
@@ -100,6 +128,10 @@ class SunDirectionResidual {
     W_ = directionSqrtInformation(sun_k_measured, sigma, sigma_strong, strong_axis);
     b_hat_ = b_hat;
   }
+  // The up bias form (kBaseCorrectionAndUpBias): the bias block is (db_x, db_z), added to the
+  // estimate up_b_hat (turnAboutCameraXZ).
+  void useUpBias() { up_bias_ = true; }
+  void setUpBiasEstimate(const Eigen::Vector2d& up_b_hat) { up_b_hat_ = up_b_hat; }
 
   template <typename T>
   bool operator()(const T* q_k_b, T* residual) const {
@@ -133,7 +165,11 @@ class SunDirectionResidual {
   template <typename T>
   bool evaluate(const T* q_k_b, const T* delta, const T* bias, T* residual) const {
     Eigen::Matrix<T, 3, 1> s_hat = predictSun(q_k_b, delta, sun_b_);
-    if (bias != nullptr) s_hat = turnAboutCameraY(s_hat, T(b_hat_) + bias[0]);
+    if (bias != nullptr && up_bias_) {
+      s_hat = turnAboutCameraXZ(s_hat, T(up_b_hat_.x()) + bias[0], T(up_b_hat_.y()) + bias[1]);
+    } else if (bias != nullptr) {
+      s_hat = turnAboutCameraY(s_hat, T(b_hat_) + bias[0]);
+    }
     const Eigen::Matrix<T, 3, 1> e = s_hat - sun_k_.cast<T>();
     Eigen::Map<Eigen::Matrix<T, 3, 1>> r(residual);
     r = W_.cast<T>() * e;
@@ -144,6 +180,8 @@ class SunDirectionResidual {
   Eigen::Vector3d sun_k_;
   Eigen::Matrix3d W_ = Eigen::Matrix3d::Identity();  // square-root information
   double b_hat_ = 0.0;
+  bool up_bias_ = false;
+  Eigen::Vector2d up_b_hat_ = Eigen::Vector2d::Zero();
 };
 
 // Azimuth-only sun residual (Sun-CNN), free of elevation bias.
@@ -244,27 +282,51 @@ class AttitudePriorResidual {
   Eigen::Matrix3d L_;
 };
 
-// Joint prior on the base-attitude correction and the azimuth bias's correction:
-// r = L (delta, db) with L^T L the inverse of their 4x4 covariance.
-class AttitudeBiasPriorResidual {
+// Joint prior on the base-attitude correction and the bias states' corrections:
+// r = L x with L^T L the inverse of their covariance and x = (delta, bias entries) in block order,
+// kN = 3 + the bias entries (4: the sun's azimuth; 5: the up's turn; 6: both, the sun's first).
+// L is the top-left kN x kN of a matrix the caller owns and sets before each solve.
+using JointPriorMatrix = Eigen::Matrix<double, 6, 6>;
+template <int kN>
+class JointPriorResidual {
+  static_assert(kN >= 4 && kN <= 6);
+
  public:
-  explicit AttitudeBiasPriorResidual(const Eigen::Matrix4d& sqrt_information)
-      : L_(sqrt_information) {}
-  void set(const Eigen::Matrix4d& sqrt_information) { L_ = sqrt_information; }
+  explicit JointPriorResidual(const JointPriorMatrix* sqrt_information) : L_(sqrt_information) {}
+  // kN = 4 or 5: blocks delta (3), bias (kN - 3).
   template <typename T>
   bool operator()(const T* delta, const T* bias, T* residual) const {
-    const Eigen::Matrix<T, 4, 1> x(delta[0], delta[1], delta[2], bias[0]);
-    Eigen::Map<Eigen::Matrix<T, 4, 1>> r(residual);
-    r = L_.cast<T>() * x;
-    return true;
+    T x[kN];
+    for (int i = 0; i < 3; ++i) x[i] = delta[i];
+    for (int i = 3; i < kN; ++i) x[i] = bias[i - 3];
+    return apply(x, residual);
   }
-  static ceres::CostFunction* Create(const Eigen::Matrix4d& sqrt_information) {
-    return new ceres::AutoDiffCostFunction<AttitudeBiasPriorResidual, 4, 3, 1>(
-        new AttitudeBiasPriorResidual(sqrt_information));
+  // kN = 6: blocks delta (3), the sun's bias (1), the up's (2).
+  template <typename T>
+  bool operator()(const T* delta, const T* sun_bias, const T* up_bias, T* residual) const {
+    const T x[kN] = {delta[0], delta[1], delta[2], sun_bias[0], up_bias[0], up_bias[1]};
+    return apply(x, residual);
+  }
+  static ceres::CostFunction* Create(const JointPriorMatrix* sqrt_information) {
+    auto* r = new JointPriorResidual(sqrt_information);
+    if constexpr (kN == 6) {
+      return new ceres::AutoDiffCostFunction<JointPriorResidual, 6, 3, 1, 2>(r);
+    } else {
+      return new ceres::AutoDiffCostFunction<JointPriorResidual, kN, 3, kN - 3>(r);
+    }
   }
 
  private:
-  Eigen::Matrix4d L_;
+  template <typename T>
+  bool apply(const T* x, T* residual) const {
+    for (int i = 0; i < kN; ++i) {
+      T sum(0.0);
+      for (int j = 0; j < kN; ++j) sum += T((*L_)(i, j)) * x[j];
+      residual[i] = sum;
+    }
+    return true;
+  }
+  const JointPriorMatrix* L_;
 };
 
 }  // namespace sunvo::sunfusion

@@ -103,24 +103,32 @@ inline void addStartTiltOptions(CLI::App& app, double& pitch_error_deg, double& 
                "setting; worlds whose up is known)");
 }
 
-// A sun azimuth bias state's std (deg) and correlation length (frames) as --<prefix>bias-state-deg
-// and --<prefix>bias-state-frames, with the fusion's ranges; `std_help` describes the std.
+// A bias state's std (deg) and correlation length (frames) as --<prefix>bias-state-deg and
+// --<prefix>bias-state-frames, in [0, max_sigma_deg] and [1, max_length_frames] (the fusion's
+// ranges; the sun's azimuth bias by default); `std_help` describes the std.
 inline void addBiasStateOptions(CLI::App& app, double& sigma_deg, double& length_frames,
-                                const std::string& prefix, const std::string& std_help) {
+                                const std::string& prefix, const std::string& std_help,
+                                double max_sigma_deg = 45.0, double max_length_frames = 1e6) {
   app.add_option("--" + prefix + "bias-state-deg", sigma_deg, std_help)
-      ->check(CLI::Range(0.0, 45.0));
+      ->check(CLI::Range(0.0, max_sigma_deg));
   app.add_option("--" + prefix + "bias-state-frames", length_frames,
                  "its correlation length, frames")
-      ->check(CLI::Range(1.0, 1e6));
+      ->check(CLI::Range(1.0, max_length_frames));
 }
 
-// The fusion's sun azimuth bias state (sunfusion::SunFusionOptions, docs/fusion_bias.md), the same
-// in every program that runs the fusion: --bias-state-deg, --bias-state-frames.
+// The fusion's bias states (sunfusion::SunFusionOptions), the same in every program that runs the
+// fusion: the sun's azimuth bias (docs/fusion_bias.md) as --bias-state-deg, --bias-state-frames,
+// and the vertical cue's (docs/fusion_bias.md) as --up-bias-state-deg, --up-bias-state-frames.
 template <class FusionOptions>
 void addBiasStateOptions(CLI::App& app, FusionOptions& fusion) {
   addBiasStateOptions(app, fusion.sun_bias_sigma_deg, fusion.sun_bias_length_frames, "",
                       "the fusion's sun azimuth bias state: its std, deg (0 = none; the true "
                       "vector runs without it)");
+  addBiasStateOptions(app, fusion.vertical_bias_sigma_deg, fusion.vertical_bias_length_frames,
+                      "up-",
+                      "the fusion's bias state of the vertical cue (a turn of its up about the "
+                      "camera's x and z axes): its std, deg (0 = none)",
+                      10.0, 1e7);
 }
 
 // The stereo self-calibration's drift rate (selfcal::StereoSelfCalibrationOptions,

@@ -96,12 +96,15 @@ struct ReplayRun {
   std::vector<selfcal::SelfCalibrationReport> self_calibration_log;  // per frame (if enabled)
   // The fusion's attitude walks after each frame (runs with a sun or the vertical cue): the
   // tilt's and the heading's walk, deg/frame, and with the likelihood rule the bank's estimate of
-  // the tilt's own walk (deg/frame) and of the cue's noise scale (true / reported std); 0 without.
+  // the tilt's own walk (deg/frame) and of the cue's noise scale (true / reported std), and the
+  // cue's bias state (its turn about the camera's x and z axes, deg); 0 without.
   struct WalkSample {
     double tilt_deg = 0.0;
     double heading_deg = 0.0;
     double bank_tilt_deg = 0.0;
     double noise_scale = 0.0;
+    double up_bias_x_deg = 0.0;
+    double up_bias_z_deg = 0.0;
   };
   std::vector<WalkSample> walk_log;
   // Per processed frame, the front end's observations before any self-calibration correction
