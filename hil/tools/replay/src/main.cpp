@@ -100,6 +100,7 @@ int main(int argc, char** argv) {
       app, "--vertical-drift-rule", options.fusion.vertical_drift_adaptation,
       "how the tilt's walk follows the cue: likelihood (default), persistence or "
       "evidence (docs/vertical.md)");
+  sunvo::cli::addTiltWalkRangeOptions(app, options.fusion);
   app.add_option("--world-up-alignment-frames", options.world_up_alignment_frames,
                  "the cue's answers of the first N frames measure the world's up (-1: 50 when the "
                  "world is the first camera, which nobody levelled; 0 in ENU)")

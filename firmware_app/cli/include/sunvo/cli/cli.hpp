@@ -131,6 +131,24 @@ void addBiasStateOptions(CLI::App& app, FusionOptions& fusion) {
                       10.0, 1e7);
 }
 
+// The ranges the likelihood rule chooses the tilt's walk from (sunfusion::SunFusionOptions,
+// docs/vertical.md), the same in every program that runs the fusion: --vertical-max-drift-deg
+// (the fastest walk, deg/frame), --likelihood-noise-min and --likelihood-noise-max (the cue's
+// noise scales, true / reported std).
+template <class FusionOptions>
+void addTiltWalkRangeOptions(CLI::App& app, FusionOptions& fusion) {
+  app.add_option("--vertical-max-drift-deg", fusion.vertical_max_drift_deg_per_frame,
+                 "the fastest tilt walk the cue's answers may choose, deg/frame")
+      ->check(CLI::Range(0.0, 5.0));
+  app.add_option("--likelihood-noise-min", fusion.likelihood_noise_min,
+                 "the smallest noise scale of the cue (true / reported std) the likelihood rule "
+                 "considers")
+      ->check(CLI::Range(1e-3, 100.0));
+  app.add_option("--likelihood-noise-max", fusion.likelihood_noise_max,
+                 "the largest such noise scale")
+      ->check(CLI::Range(1e-3, 100.0));
+}
+
 // The stereo self-calibration's drift rate (selfcal::StereoSelfCalibrationOptions,
 // docs/selfcal.md), the same in every program that runs it: --self-calib-rate-deg,
 // --self-calib-rate-frames.
