@@ -55,12 +55,12 @@ Eigen::Matrix<T, 3, 1> turnAboutCameraY(const Eigen::Matrix<T, 3, 1>& s, const T
 
 // The vertical cue's error that stays alike over a drive (SunFusionOptions::
 // vertical_bias_sigma_deg) is a small turn of the measured "up" about the camera's x axis (pitch)
-// and z axis (roll) by b = (b_x, b_z): the measurement is predicted as Exp((b_x, 0, b_z)) s_hat_k.
+// and z axis (roll) by c = (c_x, c_z): the measurement is predicted as Exp((c_x, 0, c_z)) s_hat_k.
 // A turn about y does not move an up along y (a level camera's) and is not a state.
 template <typename T>
-Eigen::Matrix<T, 3, 1> turnAboutCameraXZ(const Eigen::Matrix<T, 3, 1>& s, const T& b_x,
-                                         const T& b_z) {
-  const T angle_axis[3] = {b_x, T(0.0), b_z};
+Eigen::Matrix<T, 3, 1> turnAboutCameraXZ(const Eigen::Matrix<T, 3, 1>& s, const T& c_x,
+                                         const T& c_z) {
+  const T angle_axis[3] = {c_x, T(0.0), c_z};
   Eigen::Matrix<T, 3, 1> turned;
   ceres::AngleAxisRotatePoint(angle_axis, s.data(), turned.data());
   return turned;
