@@ -19,8 +19,6 @@ constexpr double kDeg = M_PI / 180.0;
 using RowsJacobian = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor, 3, 3>;
 using RowsSquare = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 3, 3>;
 using RowsVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 3, 1>;
-// A cost's Jacobian over the augmented state (3 to 6 columns).
-using ActiveJacobian = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor, 3, 6>;
 
 }  // namespace
 
@@ -169,12 +167,8 @@ Status SunWindowTerm::onSolve(backend::BundleWindow& window) {
   // Prior of this solve's base correction delta_b = C_b_w dtheta_w: N(0, C_b_w P_theta C_w_b),
   // jointly with the bias states' corrections where they are states.
   const Eigen::Matrix3d C_b_w = window.T_w_b().linear().transpose();
-  BasePrior prior;
-  prior.P = activeCovariance(C_b_w);
-  prior.n = num_active_;
-  prior.sun_col = biasEnabled() ? 3 : -1;
-  prior.up_col = upBiasEnabled() ? 3 + (biasEnabled() ? 1 : 0) : -1;
-  const Eigen::Matrix3d P_b = prior.P.topLeftCorner<3, 3>();
+  const ActiveMatrix prior = activeCovariance(C_b_w);
+  const Eigen::Matrix3d P_b = prior.topLeftCorner<3, 3>();
   for (int i = kChannels; i < window.size() * kChannels; ++i) {
     const int s = i / kChannels, channel = i % kChannels;
     const std::size_t ring =
@@ -188,9 +182,7 @@ Status SunWindowTerm::onSolve(backend::BundleWindow& window) {
     const Eigen::Vector3d sun_w = channel == 0 ? p.obs.sun_w : worldUp();
     const Eigen::Vector3d sun_b = C_b_w * sun_w;
     bool cost_built = false;  // p.cost already holds this solve's residual
-    // The cost's bias block, if its channel's bias is a state.
-    double* const bias_block = channel == 0 ? (biasEnabled() ? &bias_delta_ : nullptr)
-                                            : (upBiasEnabled() ? up_bias_delta_.data() : nullptr);
+    double* const bias_block = biasBlock(channel);
     if (!p.decided) {
       Eigen::Vector3d predicted_c = window.T_k_b(s).linear() * sun_b;
       if (bias_block != nullptr && channel == 0) predicted_c = turnAboutCameraY(predicted_c, bias_);
@@ -255,10 +247,11 @@ Status SunWindowTerm::onSolve(backend::BundleWindow& window) {
       SUNVO_RETURN_IF_ERROR(window.addPoseResidual(s, p.cost, loss_.get()));
     }
   }
-  if (estimate && num_used_ > 0 && prior.n > 3) {
+  if (estimate && num_used_ > 0 && num_active_ > 3) {
     // Square-root information of the joint prior over (delta_b, the bias corrections).
-    const ActiveMatrix info = prior.P.inverse();
-    joint_prior_L_.topLeftCorner(prior.n, prior.n) = Eigen::LLT<ActiveMatrix>(info).matrixU();
+    const ActiveMatrix info = prior.inverse();
+    joint_prior_L_.topLeftCorner(num_active_, num_active_) =
+        Eigen::LLT<ActiveMatrix>(info).matrixU();
     std::array<double*, 3> extra{delta_.data()};
     std::size_t blocks = 1;
     if (biasEnabled()) extra[blocks++] = &bias_delta_;
@@ -281,7 +274,6 @@ void SunWindowTerm::onSolved(backend::BundleWindow& window) {
   // Information of the sun residuals about the active state (delta_b, the bias corrections) at
   // the solution; columns as in the solve's prior.
   const int n = num_active_;
-  const int sun_col = 3, up_col = 3 + (biasEnabled() ? 1 : 0);
   ActiveMatrix info = ActiveMatrix::Zero(n, n);
   Eigen::Matrix3d info_t = Eigen::Matrix3d::Zero();  // about delta_b alone (no bias state)
   for (int i = 0; i < num_used_; ++i) {
@@ -297,17 +289,15 @@ void SunWindowTerm::onSolved(backend::BundleWindow& window) {
     Eigen::Vector3d r;
     int m = 0, cols = 0;
     // The cost's bias block at this solve's correction.
-    const bool sun_cost = used_in_solve_[static_cast<std::size_t>(i)] % kChannels == 0;
-    const double* bias = sun_cost ? &bias_delta_ : up_bias_delta_.data();
-    if (!evaluateAt(*p.cost, window.T_k_b(slot), delta_.data(), bias, &r, &J_d, &J_b, &cols, &m)) {
+    const int channel = used_in_solve_[static_cast<std::size_t>(i)] % kChannels;
+    if (!evaluateAt(*p.cost, window.T_k_b(slot), delta_.data(), biasBlock(channel), &r, &J_d, &J_b,
+                    &cols, &m)) {
       continue;
     }
     const RowsJacobian J_t = J_d.topRows(m);
     info_t += J_t.transpose() * J_t;
     if (n == 3) continue;
-    ActiveJacobian J = ActiveJacobian::Zero(m, n);
-    J.leftCols(3) = J_t;
-    if (cols > 0) J.middleCols(cols == 1 ? sun_col : up_col, cols) = J_b.topLeftCorner(m, cols);
+    const ActiveJacobian J = activeJacobian(J_d, J_b, cols, m);
     info += J.transpose() * J;
   }
   const Eigen::Vector3d delta_b(delta_[0], delta_[1], delta_[2]);
@@ -454,7 +444,7 @@ bool SunWindowTerm::evaluateAt(const ceres::CostFunction& cost, const Isometry3&
 }
 
 bool SunWindowTerm::innovation(const ceres::CostFunction& cost, const Isometry3& T_k_b,
-                               const BasePrior& prior, Innovation* out) const {
+                               const ActiveMatrix& P, Innovation* out) const {
   const double zero[3] = {0.0, 0.0, 0.0};
   int n = 0, cols = 0;
   BiasJacobian J_b;
@@ -464,26 +454,39 @@ bool SunWindowTerm::innovation(const ceres::CostFunction& cost, const Isometry3&
   out->dof = n;
   const RowsJacobian J = out->J.topRows(n);
   const RowsVector rn = out->r.head(n);
-  if (prior.n > 3) {
+  if (P.rows() > 3) {
     // Over the active state: S = J_a P J_a^T + I, the bias states' share included; the predicted
     // correction of delta_b is the top of P J_a^T S^-1 r.
-    ActiveJacobian J_a = ActiveJacobian::Zero(n, prior.n);
-    J_a.leftCols(3) = J;
-    if (cols > 0) {
-      J_a.middleCols(cols == 1 ? prior.sun_col : prior.up_col, cols) = J_b.topLeftCorner(n, cols);
-    }
-    const RowsSquare S = J_a * prior.P * J_a.transpose() + RowsSquare::Identity(n, n);
+    const ActiveJacobian J_a = activeJacobian(out->J, J_b, cols, n);
+    const RowsSquare S = J_a * P * J_a.transpose() + RowsSquare::Identity(n, n);
     const RowsVector Sinv_r = S.ldlt().solve(rn);
     out->nis = rn.dot(Sinv_r);
-    out->move_b = (prior.P * J_a.transpose() * Sinv_r).head<3>();
+    out->move_b = (P * J_a.transpose() * Sinv_r).head<3>();
   } else {
-    const Eigen::Matrix3d P_b = prior.P.topLeftCorner<3, 3>();
+    const Eigen::Matrix3d P_b = P.topLeftCorner<3, 3>();
     const RowsSquare S = J * P_b * J.transpose() + RowsSquare::Identity(n, n);
     const RowsVector Sinv_r = S.ldlt().solve(rn);
     out->nis = rn.dot(Sinv_r);
     out->move_b = P_b * J.transpose() * Sinv_r;
   }
   return std::isfinite(out->nis) && out->move_b.allFinite();
+}
+
+SunWindowTerm::ActiveJacobian SunWindowTerm::activeJacobian(
+    const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>& J_d, const BiasJacobian& J_b, int cols,
+    int m) const {
+  ActiveJacobian J = ActiveJacobian::Zero(m, num_active_);
+  J.leftCols(3) = J_d.topRows(m);
+  if (cols > 0) {
+    const int first = cols == 1 ? 3 : 3 + (biasEnabled() ? 1 : 0);
+    J.middleCols(first, cols) = J_b.topLeftCorner(m, cols);
+  }
+  return J;
+}
+
+double* SunWindowTerm::biasBlock(int channel) {
+  if (channel == 0) return biasEnabled() ? &bias_delta_ : nullptr;
+  return upBiasEnabled() ? up_bias_delta_.data() : nullptr;
 }
 
 SunWindowTerm::ActiveMatrix SunWindowTerm::activeCovariance(const Eigen::Matrix3d& C) const {

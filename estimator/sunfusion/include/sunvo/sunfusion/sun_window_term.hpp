@@ -262,17 +262,20 @@ class SunWindowTerm {
   ActiveMatrix activeCovariance(const Eigen::Matrix3d& C) const;
   // Writes an active covariance in the world frame back into Pa_.
   void setActiveCovariance(const ActiveMatrix& P);
-  // The prior of a solve: the active covariance in the base frame, its size, and where the
-  // sun's and the up's bias columns are (-1: not a state).
-  struct BasePrior {
-    ActiveMatrix P;
-    int n = 3;
-    int sun_col = -1;
-    int up_col = -1;
-  };
+  // A cost's Jacobian over the active state (3 to 6 columns).
+  using ActiveJacobian =
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor, 3, 6>;
+  // The m rows of a cost's Jacobians wrt delta_b (J_d) and its bias block (J_b, cols columns) in
+  // the active state's columns: a 1-column block is the sun's azimuth (right after the
+  // attitude), a 2-column one the up's turn (after the sun's, if that is a state).
+  ActiveJacobian activeJacobian(const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>& J_d,
+                                const BiasJacobian& J_b, int cols, int m) const;
+  // The bias block of a channel's costs (0 sun, 1 vertical); nullptr where that bias is no state.
+  double* biasBlock(int channel);
   // A measurement's innovation at delta_b = 0, from its base-correction cost: whitened residual r
   // (dof rows) and its Jacobian J wrt delta_b; nis = r^T (J_a P J_a^T + I)^-1 r with J_a its
-  // Jacobian over the active state (innovation gate). False if not finite.
+  // Jacobian over the active state and P the solve's prior (activeCovariance in the base frame)
+  // (innovation gate). False if not finite.
   struct Innovation {
     Eigen::Vector3d r = Eigen::Vector3d::Zero();
     Eigen::Matrix<double, 3, 3, Eigen::RowMajor> J =
@@ -281,7 +284,7 @@ class SunWindowTerm {
     double nis = 0.0;
     Eigen::Vector3d move_b = Eigen::Vector3d::Zero();  // predicted correction of delta_b
   };
-  bool innovation(const ceres::CostFunction& cost, const Isometry3& T_k_b, const BasePrior& prior,
+  bool innovation(const ceres::CostFunction& cost, const Isometry3& T_k_b, const ActiveMatrix& P,
                   Innovation* out) const;
   // One adaptation step of q_theta from an accepted measurement's innovation (C_w_b: base;
   // channel 0 sun, 1 vertical).
