@@ -76,18 +76,31 @@ class SunWindowTermTest : public ::testing::Test {
         window_.addFrame(sequence - 1, t - 100'000'000, obs_b_, Isometry3::Identity()).isOk());
     ASSERT_TRUE(window_.addFrame(sequence, t, obs_k_, T_k_b_true_).isOk());
     ASSERT_TRUE(window_.solve());
+    // The next window starts from this one's corrected base (the truth of every base is C_b_w = I):
+    // the corrections persist, as on a drive.
+    if (carry_corrections_) T_w_b_est_ = window_.T_w_b();
   }
 
-  // 21 windows that all start from the same 2 deg base error: one term sees it through precise
-  // measurements (sigma 0.01, 0.57 deg), the other through imprecise ones (sigma 0.3, 17 deg).
+  // 21 windows that start from the same 2 deg base error (each from the last one's corrected base
+  // with carry_corrections_): one term sees it through precise measurements (sigma 0.01,
+  // 0.57 deg), the other through imprecise ones (sigma 0.3, 17 deg).
   void solvePreciseAndImprecise(const SunFusionOptions& opt, SunWindowTerm* precise,
                                 SunWindowTerm* imprecise) {
     ASSERT_TRUE(precise->init(opt).isOk());
     ASSERT_TRUE(imprecise->init(opt).isOk());
-    for (std::uint64_t k = 1; k <= 41; k += 2) {
-      solveAt(precise, k, perfectObservation(SunMeasurementKind::kFull3d, 0.01));
-      solveAt(imprecise, k, perfectObservation(SunMeasurementKind::kFull3d, 0.3));
+    const Isometry3 start = T_w_b_est_;
+    for (SunWindowTerm* term : {precise, imprecise}) {
+      T_w_b_est_ = start;
+      const double sigma = term == precise ? 0.01 : 0.3;
+      for (std::uint64_t k = 1; k <= 41; k += 2) {
+        solveAt(term, k, perfectObservation(SunMeasurementKind::kFull3d, sigma));
+      }
+      // The error a sun direction can see: normal to the sun.
+      const Eigen::Vector3d e = logSO3(T_w_b_est_.linear());
+      (term == precise ? precise_error_deg_ : imprecise_error_deg_) =
+          (e - e.dot(sun_w_) * sun_w_).norm() * 180.0 / M_PI;
     }
+    T_w_b_est_ = start;
   }
 
   SunObservation perfectObservation(SunMeasurementKind kind, double sigma) const {
@@ -106,6 +119,11 @@ class SunWindowTermTest : public ::testing::Test {
   StereoCamera camera_;
   backend::BundleWindow window_;
   Isometry3 T_k_b_true_, T_w_b_est_;
+  bool carry_corrections_ = false;  // solveAt: false = every window starts from T_w_b_est_
+  // solvePreciseAndImprecise with carry_corrections_: each term's base error at the end, its part
+  // normal to the sun, deg.
+  double precise_error_deg_ = 0.0;
+  double imprecise_error_deg_ = 0.0;
   std::vector<backend::WindowObservation> obs_b_, obs_k_;
   Eigen::Vector3d sun_w_;
 };

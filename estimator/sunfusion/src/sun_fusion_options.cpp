@@ -80,6 +80,17 @@ Status SunFusionOptions::validate() const {
     if (!(likelihood_forgetting > 0.0 && likelihood_forgetting <= 1.0)) {
       return invalidArgument("fusion.likelihood_forgetting out of range (0, 1]");
     }
+    if (likelihood_up_bias_scales < 1 || likelihood_up_bias_scales > WalkBank::kMaxBiasScales) {
+      return invalidArgument("fusion.likelihood_up_bias_scales out of range [1, 4]");
+    }
+    if (!(likelihood_up_bias_max_deg > 0.0 && likelihood_up_bias_max_deg <= 10.0)) {
+      return invalidArgument("fusion.likelihood_up_bias_max_deg out of range (0, 10]");
+    }
+    if (likelihood_up_bias_scales > 1 && vertical_bias_sigma_deg > 0.0) {
+      return invalidArgument(
+          "fusion.likelihood_up_bias_scales > 1 and vertical_bias_sigma_deg > 0: the cue's bias "
+          "is estimated one way or the other, not both");
+    }
     if (!(min_drift_deg_per_frame > 0.0)) {
       return invalidArgument(
           "fusion.min_drift_deg_per_frame must be > 0 with vertical_drift_adaptation likelihood "

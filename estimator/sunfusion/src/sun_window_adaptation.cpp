@@ -30,15 +30,15 @@ void SunWindowTerm::adaptDrift(const Innovation& inn, const Eigen::Matrix3d& C_w
       persistence_T_ = inflateToEvidence(persistence_I_, persistence_g_);
       return;
     case DriftAdaptation::kPersistence: {
-      // r ~ r0 + J delta_b and delta_b = C_b_w dtheta_w, so H = J C_b_w is the Jacobian wrt the
-      // world-frame attitude error. If dtheta_w stayed constant while the filter ignores it, the
-      // whitened innovations r_i ~ N(H_i dtheta_w, I) and the least-squares estimate from all of
-      // them, I^+ g with g = sum H_i^T r_i and I = sum H_i^T H_i, has the chi-square statistic
-      // T = g^T I^+ g with rank(I) dof when dtheta_w = 0 (noise only). The sums forget by
-      // persistence_forgetting per measurement, so T weighs the recent drift; a Huber weight
-      // caps an outlier's pull at persistence_huber sigmas per row. Once the vertical channel
-      // steps the tilt's walk (split below), the sums forget on its answers only: a sun answer
-      // between two of them would halve the memory of the cue's evidence the tilt's test reads.
+      // H = errorJacobian: r ~ H dtheta_w, dtheta_w the world-frame attitude error. If dtheta_w
+      // stayed constant while the filter ignores it, the whitened innovations r_i ~ N(H_i dtheta_w,
+      // I) and the least-squares estimate from all of them, I^+ g with g = sum H_i^T r_i and I =
+      // sum H_i^T H_i, has the chi-square statistic T = g^T I^+ g with rank(I) dof when dtheta_w =
+      // 0 (noise only). The sums forget by persistence_forgetting per measurement, so T weighs the
+      // recent drift; a Huber weight caps an outlier's pull at persistence_huber sigmas per row.
+      // Once the vertical channel steps the tilt's walk (split below), the sums forget on its
+      // answers only: a sun answer between two of them would halve the memory of the cue's evidence
+      // the tilt's test reads.
       const bool forget = !(splitByGravity() && channel == 0 && vertical_in_sums_);
       accumulate(inn, C_w_b, &persistence_I_, &persistence_g_,
                  forget ? options_.persistence_forgetting : 1.0);
@@ -65,10 +65,27 @@ void SunWindowTerm::adaptDrift(const Innovation& inn, const Eigen::Matrix3d& C_w
           drift_deg_per_frame_ = options_.min_drift_deg_per_frame;
         } else if (channel == 1 && tiltByLikelihood()) {
           // The walk the cue's innovations make most likely (walk_bank.hpp), an outlier's pull
-          // capped as in the sums.
+          // capped as in the sums. With a bias axis the bank sees the answer as it came: the
+          // innovation at c = 0 is r + J_up c_removed (J_up = d r / d c).
           vertical_in_sums_ = true;
-          const Eigen::Matrix3d H = inn.J * C_w_b.transpose();
-          tilt_bank_.update(H, huberWeight(inn) * inn.r, inn.dof);
+          Eigen::Matrix3d H = errorJacobian(inn.J, C_w_b);
+          Eigen::Vector3d r_as_came = huberWeight(inn) * (inn.r + inn.J_up * inn.up_bias_removed);
+          Eigen::Matrix<double, 3, 2> H_c = inn.J_up;
+          int rows = inn.dof;
+          if (inn.radial.squaredNorm() > 0.0) {
+            // The rows of a 3-D direction's residual across the measured direction only: its
+            // radial row is zero to first order, and read as a row of noise it would make the
+            // noise scales read sqrt(2/3) of the cue's true noise (the whitened residual's radial
+            // direction is the measured one, W s = s / sigma).
+            const Eigen::Vector3d t1 = inn.radial.unitOrthogonal();
+            Eigen::Matrix3d Q;
+            Q << t1, inn.radial.cross(t1), inn.radial;
+            H = Q.transpose() * H;
+            r_as_came = Q.transpose() * r_as_came;
+            H_c = Q.transpose() * H_c;
+            rows = 2;
+          }
+          tilt_bank_.update(H, H_c, r_as_came, rows);
           drift_deg_per_frame_ =
               std::clamp(tilt_bank_.walk() / kDeg, options_.min_drift_deg_per_frame,
                          options_.vertical_max_drift_deg_per_frame);
@@ -137,7 +154,7 @@ void SunWindowTerm::accumulate(const Innovation& inn, const Eigen::Matrix3d& C_w
   Eigen::Vector3d r = inn.r;
   J.bottomRows(3 - m).setZero();
   r.tail(3 - m).setZero();
-  const Eigen::Matrix3d H = J * C_w_b.transpose();
+  const Eigen::Matrix3d H = errorJacobian(J, C_w_b);
   *g = lambda * *g + H.transpose() * (huberWeight(inn) * r);
   *I = lambda * *I + H.transpose() * H;
 }

@@ -87,6 +87,9 @@ Status SunWindowTerm::init(const SunFusionOptions& options) {
     bank.noise_scales = options.likelihood_noise_scales;
     bank.initial_sigma_rad = s0;
     bank.forgetting = options.likelihood_forgetting;
+    bank.up_bias_scales = options.likelihood_up_bias_scales;
+    bank.up_bias_max_rad = options.likelihood_up_bias_max_deg * kDeg;
+    bank.up_bias_length_frames = options.vertical_bias_length_frames;
     SUNVO_RETURN_IF_ERROR(tilt_bank_.init(bank));
   }
   alignment_gate_ = options.vertical_gate;
@@ -183,6 +186,15 @@ Status SunWindowTerm::onSolve(backend::BundleWindow& window) {
     const Eigen::Vector3d sun_b = C_b_w * sun_w;
     bool cost_built = false;  // p.cost already holds this solve's residual
     double* const bias_block = biasBlock(channel);
+    if (!p.decided && channel == 1 && bankUpBias()) {
+      // Two-stage: the answer as the bank's estimate of the cue's bias says it was meant,
+      // Exp(-c) up_c (the residual's Exp(c) s_hat_k moved to the measurement).
+      p.up_bias_removed = tilt_bank_.upBias();
+      const Eigen::Matrix3d unturn =
+          expSO3(Eigen::Vector3d(-p.up_bias_removed.x(), 0.0, -p.up_bias_removed.y()));
+      p.obs.measurement.sun_c = unturn * p.obs.measurement.sun_c;
+      p.obs.measurement.strong_axis_c = unturn * p.obs.measurement.strong_axis_c;
+    }
     if (!p.decided) {
       Eigen::Vector3d predicted_c = window.T_k_b(s).linear() * sun_b;
       if (bias_block != nullptr && channel == 0) predicted_c = turnAboutCameraY(predicted_c, bias_);
@@ -215,6 +227,15 @@ Status SunWindowTerm::onSolve(backend::BundleWindow& window) {
         Innovation inn;
         const bool finite = innovation(*p.cost, window.T_k_b(s), prior, &inn);
         if (finite) last_nis_ = inn.nis;
+        if (p.obs.measurement.kind != SunMeasurementKind::kAzimuthOnly && inn.dof == 3) {
+          inn.radial = p.obs.measurement.sun_c.normalized();
+        }
+        if (channel == 1 && bankUpBias()) {
+          // J = W [s_k]x C_k_b (the base correction's Jacobian), so W [s_k]x = J C_b_k.
+          const Eigen::Matrix3d W_s = inn.J * window.T_k_b(s).linear().transpose();
+          inn.J_up << W_s.col(0), W_s.col(2);
+          inn.up_bias_removed = p.up_bias_removed;
+        }
         if (!finite ||
             (options_.innovation_gate_chi2 > 0.0 && inn.nis > options_.innovation_gate_chi2)) {
           r = GateResult::kRejectedInnovation;

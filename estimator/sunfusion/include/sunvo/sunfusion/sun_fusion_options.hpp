@@ -125,6 +125,14 @@ struct SunFusionOptions {
   double likelihood_noise_min = 0.35;
   double likelihood_noise_max = 2.0;
   double likelihood_forgetting = 0.99;
+  // kLikelihood: the bank's third axis, the cue's bias (walk_bank.hpp): its stds are 0 and then
+  // halving down to likelihood_up_bias_max_deg (deg, (0, 10]), likelihood_up_bias_scales of them
+  // in all, [1, 4]; 1 = no bias axis. With one the fusion takes the bank's estimate of the bias
+  // out of the cue's answers before it gates and fuses them (two-stage bias estimation); the
+  // bias's correlation length is vertical_bias_length_frames. Not with vertical_bias_sigma_deg
+  // (a bias state of the fusion's own).
+  int likelihood_up_bias_scales = 1;
+  double likelihood_up_bias_max_deg = 0.2;
   double drift_adaptation_rate = 0.1;  // (0, 1]: log-step of q_theta per measurement (median rule)
   // Persistence rule: forgetting factor of the sums per measurement, (0, 1) (0.98: about the last
   // 50 measurements); false-alarm probability of the test on T, (0, 0.5]; log-steps up and down
@@ -193,6 +201,8 @@ struct SunFusionOptions {
     v("likelihood_noise_min", s.likelihood_noise_min);
     v("likelihood_noise_max", s.likelihood_noise_max);
     v("likelihood_forgetting", s.likelihood_forgetting);
+    v("likelihood_up_bias_scales", s.likelihood_up_bias_scales);
+    v("likelihood_up_bias_max_deg", s.likelihood_up_bias_max_deg);
     v("drift_adaptation_rate", s.drift_adaptation_rate);
     v("persistence_forgetting", s.persistence_forgetting);
     v("persistence_false_alarm", s.persistence_false_alarm);

@@ -206,11 +206,14 @@ class SunWindowTerm {
   // The sun's azimuth bias state (sun_bias_sigma_deg > 0): estimate and std, rad (0 without it).
   double sunAzimuthBias() const { return bias_; }
   double sunAzimuthBiasSigma() const { return std::sqrt(std::max(Pa_(kSunBias, kSunBias), 0.0)); }
-  // The vertical cue's bias state (vertical_bias_sigma_deg > 0): its turn about the camera's x and
-  // z axes and their std, rad (0 without it).
-  const Eigen::Vector2d& upBias() const { return up_bias_; }
+  // The vertical cue's bias: its turn about the camera's x and z axes and their std, rad; the
+  // fusion's state (vertical_bias_sigma_deg > 0) or the walk bank's estimate
+  // (likelihood_up_bias_scales > 1), 0 without either.
+  Eigen::Vector2d upBias() const { return bankUpBias() ? tilt_bank_.upBias() : up_bias_; }
   Eigen::Vector2d upBiasSigma() const {
-    return Pa_.diagonal().segment<2>(kUpBias).cwiseMax(0.0).cwiseSqrt();
+    return bankUpBias()
+               ? tilt_bank_.upBiasSigma()
+               : Eigen::Vector2d(Pa_.diagonal().segment<2>(kUpBias).cwiseMax(0.0).cwiseSqrt());
   }
 
  private:
@@ -220,6 +223,8 @@ class SunWindowTerm {
     bool accepted = false;
     bool consumed = false;                // used in a base-attitude solve already
     ceres::CostFunction* cost = nullptr;  // one of costs_[ring], set for this measurement
+    // bankUpBias: the bank's estimate of the cue's bias taken out of this answer (rad).
+    Eigen::Vector2d up_bias_removed = Eigen::Vector2d::Zero();
   };
   // The pre-built sun costs of one ring slot; each functor is owned by its cost function.
   struct CostSlot {
@@ -251,6 +256,8 @@ class SunWindowTerm {
   bool upBiasEnabled() const {
     return options_.vertical_bias_sigma_deg > 0.0 && options_.estimate_base_attitude;
   }
+  // The walk bank estimates the cue's bias, which is taken out of its answers (two-stage).
+  bool bankUpBias() const { return tiltByLikelihood() && tilt_bank_.hasUpBias(); }
   // The augmented state (dtheta_w, b, c) in Pa_'s rows, and the active rows: 3 + 1 with the sun's
   // bias + 2 with the up's, in that order.
   static constexpr int kSunBias = 3;
@@ -283,9 +290,23 @@ class SunWindowTerm {
     int dof = 0;
     double nis = 0.0;
     Eigen::Vector3d move_b = Eigen::Vector3d::Zero();  // predicted correction of delta_b
+    // bankUpBias, vertical channel: d r / d c at c = 0 (walk_bank.hpp) and the bias taken out of
+    // the answer r was computed from (the bank's members see the answer as it came).
+    Eigen::Matrix<double, 3, 2> J_up = Eigen::Matrix<double, 3, 2>::Zero();
+    Eigen::Vector2d up_bias_removed = Eigen::Vector2d::Zero();
+    // A 3-D direction's residual: the measured direction, along which the difference of two unit
+    // vectors has no first-order part (nor noise); zero for the azimuth-only residual.
+    Eigen::Vector3d radial = Eigen::Vector3d::Zero();
   };
   bool innovation(const ceres::CostFunction& cost, const Isometry3& T_k_b, const ActiveMatrix& P,
                   Innovation* out) const;
+  // d r / d e of an innovation r at the current estimate, e the world-frame error of the base's
+  // attitude (the truth is Exp(e) C_w_b): r(delta_b) ~ r + J delta_b vanishes at delta_b = C_b_w
+  // e, so r ~ -J C_b_w e. The sign matters where e is tracked across corrections (the evidence
+  // sums and the walk bank: a correction c_w leaves e - c_w).
+  static Eigen::Matrix3d errorJacobian(const Eigen::Matrix3d& J, const Eigen::Matrix3d& C_w_b) {
+    return -J * C_w_b.transpose();
+  }
   // One adaptation step of q_theta from an accepted measurement's innovation (C_w_b: base;
   // channel 0 sun, 1 vertical).
   void adaptDrift(const Innovation& inn, const Eigen::Matrix3d& C_w_b, int channel);

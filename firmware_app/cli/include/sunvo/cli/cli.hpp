@@ -134,7 +134,8 @@ void addBiasStateOptions(CLI::App& app, FusionOptions& fusion) {
 // The ranges the likelihood rule chooses the tilt's walk from (sunfusion::SunFusionOptions,
 // docs/vertical.md), the same in every program that runs the fusion: --vertical-max-drift-deg
 // (the fastest walk, deg/frame), --likelihood-noise-min and --likelihood-noise-max (the cue's
-// noise scales, true / reported std).
+// noise scales, true / reported std), --bank-up-bias and --bank-up-bias-max-deg (the cue's bias
+// stds, docs/fusion_bias.md).
 template <class FusionOptions>
 void addTiltWalkRangeOptions(CLI::App& app, FusionOptions& fusion) {
   app.add_option("--vertical-max-drift-deg", fusion.vertical_max_drift_deg_per_frame,
@@ -147,6 +148,14 @@ void addTiltWalkRangeOptions(CLI::App& app, FusionOptions& fusion) {
   app.add_option("--likelihood-noise-max", fusion.likelihood_noise_max,
                  "the largest such noise scale")
       ->check(CLI::Range(1e-3, 100.0));
+  app.add_option("--bank-up-bias", fusion.likelihood_up_bias_scales,
+                 "bias stds of the cue the likelihood rule considers (0, then halving down to "
+                 "--bank-up-bias-max-deg); 1 = none; with more the bank's bias estimate is taken "
+                 "out of the cue's answers")
+      ->check(CLI::Range(1, 4));
+  app.add_option("--bank-up-bias-max-deg", fusion.likelihood_up_bias_max_deg,
+                 "the widest such bias std, deg")
+      ->check(CLI::Range(1e-3, 10.0));
 }
 
 // The stereo self-calibration's drift rate (selfcal::StereoSelfCalibrationOptions,
