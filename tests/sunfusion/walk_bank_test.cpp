@@ -174,28 +174,47 @@ BiasRun simulateBiasedCue(double q_true_deg, double pitch_bias_deg, int bias_sca
   return out;
 }
 
-// A 0.1 deg pitch bias on a route that swings +-90 deg, the tilt walking by 0.003 deg/frame.
-// Without the bias axis the bank reads the bias, which turns in the world with the route, as a
-// faster walk (0.0047-0.0051 deg/frame over three seeds, measured 2026-11-29); with the axis
-// (stds 0, 0.05, 0.1, 0.2 deg) it finds the bias (0.046-0.089 deg in pitch, +-0.04) and the walk
-// (0.0024), and the biased members hold 97-98 % of the weight. An unbiased cue: 67-82 % stay
-// with the unbiased members and the bias is read within 0.014 deg of 0.
+// A 0.1 deg pitch bias on a route that swings +-90 deg, the tilt walking by 0.003 deg/frame;
+// medians over nine seeds (single runs scatter, and differ between x86-64 and aarch64 in the last
+// bits). Without the bias axis the bank reads the bias, which turns in the world with the route, as
+// a faster walk; with the axis (stds 0, 0.05, 0.1, 0.2 deg) it finds the bias and the walk, and the
+// biased members hold most of the weight. An unbiased cue: the unbiased members keep about their
+// prior share (half) and the bias reads near 0. Measured 2026-11-29, x86-64 / aarch64 (qemu): walk
+// 0.0050 / 0.0054 without the axis, 0.0025 / 0.0025 with it; bias 0.070 / 0.074 deg (across
+// 0.019 / 0.023), unbiased weight 0.031 / 0.027; unbiased cue: bias 0.008 / 0.015 deg, unbiased
+// weight 0.72 / 0.57.
 TEST(WalkBank, ACueBiasedOnATurningRouteIsFoundNotWalked) {
-  for (unsigned seed = 1; seed <= 3; ++seed) {
+  constexpr int kSeeds = 9;
+  std::array<double, kSeeds> without_walk{}, with_walk{}, with_bias{}, with_across{},
+      with_unbiased{}, calm_bias{}, calm_unbiased{};
+  for (unsigned seed = 1; seed <= kSeeds; ++seed) {
+    const auto i = static_cast<std::size_t>(seed - 1);
     const BiasRun without = simulateBiasedCue(0.003, 0.1, 1, seed);
     const BiasRun with = simulateBiasedCue(0.003, 0.1, 4, seed);
     const BiasRun calm = simulateBiasedCue(0.003, 0.0, 4, seed);
-    EXPECT_GT(without.bank.tilt_walk_deg, 0.004) << seed;
     EXPECT_EQ(without.up_bias_deg.norm(), 0.0);
-    EXPECT_LT(with.bank.tilt_walk_deg, 0.0035) << seed;
-    EXPECT_GT(with.up_bias_deg.x(), 0.03) << seed;
-    EXPECT_LT(with.up_bias_deg.x(), 0.15) << seed;
-    EXPECT_LT(std::abs(with.up_bias_deg.y()), 0.04) << seed;
-    EXPECT_LT(with.unbiased_weight, 0.1) << seed;
     EXPECT_GT(with.up_bias_sigma_deg.minCoeff(), 0.0);
-    EXPECT_GT(calm.unbiased_weight, 0.5) << seed;
-    EXPECT_LT(calm.up_bias_deg.norm(), 0.03) << seed;
+    without_walk[i] = without.bank.tilt_walk_deg;
+    with_walk[i] = with.bank.tilt_walk_deg;
+    with_bias[i] = with.up_bias_deg.x();
+    with_across[i] = std::abs(with.up_bias_deg.y());
+    with_unbiased[i] = with.unbiased_weight;
+    calm_bias[i] = calm.up_bias_deg.norm();
+    calm_unbiased[i] = calm.unbiased_weight;
   }
+  const auto median = [](std::array<double, kSeeds> v) {
+    std::sort(v.begin(), v.end());
+    return v[kSeeds / 2];
+  };
+  EXPECT_GT(median(without_walk), 1.3 * median(with_walk));
+  EXPECT_LT(median(with_walk), 0.0035);
+  EXPECT_GT(median(with_bias), 0.04);
+  EXPECT_LT(median(with_bias), 0.15);
+  EXPECT_LT(median(with_across), 0.04);
+  EXPECT_LT(median(with_unbiased), 0.2);
+  EXPECT_GT(median(calm_unbiased), 0.4);
+  EXPECT_GT(median(calm_unbiased), 5.0 * median(with_unbiased));
+  EXPECT_LT(median(calm_bias), 0.03);
 }
 
 TEST(WalkBank, RefusesBadSettingsAndBadAnswers) {
