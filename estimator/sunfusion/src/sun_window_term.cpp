@@ -186,16 +186,16 @@ Status SunWindowTerm::onSolve(backend::BundleWindow& window) {
     const Eigen::Vector3d sun_b = C_b_w * sun_w;
     bool cost_built = false;  // p.cost already holds this solve's residual
     double* const bias_block = biasBlock(channel);
-    if (!p.decided && channel == 1 && bankUpBias()) {
-      // Two-stage: the answer as the bank's estimate of the cue's bias says it was meant,
-      // Exp(-c) up_c (the residual's Exp(c) s_hat_k moved to the measurement).
-      p.up_bias_removed = tilt_bank_.upBias();
-      const Eigen::Matrix3d unturn =
-          expSO3(Eigen::Vector3d(-p.up_bias_removed.x(), 0.0, -p.up_bias_removed.y()));
-      p.obs.measurement.sun_c = unturn * p.obs.measurement.sun_c;
-      p.obs.measurement.strong_axis_c = unturn * p.obs.measurement.strong_axis_c;
-    }
     if (!p.decided) {
+      if (channel == 1 && bankUpBias()) {
+        // Two-stage: the answer as the bank's estimate of the cue's bias says it was meant,
+        // Exp(-c) up_c (the residual's Exp(c) s_hat_k moved to the measurement).
+        p.up_bias_removed = tilt_bank_.upBias();
+        const Eigen::Matrix3d unturn =
+            expSO3(Eigen::Vector3d(-p.up_bias_removed.x(), 0.0, -p.up_bias_removed.y()));
+        p.obs.measurement.sun_c = unturn * p.obs.measurement.sun_c;
+        p.obs.measurement.strong_axis_c = unturn * p.obs.measurement.strong_axis_c;
+      }
       Eigen::Vector3d predicted_c = window.T_k_b(s).linear() * sun_b;
       if (bias_block != nullptr && channel == 0) predicted_c = turnAboutCameraY(predicted_c, bias_);
       if (bias_block != nullptr && channel == 1) {

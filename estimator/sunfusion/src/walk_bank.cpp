@@ -158,38 +158,45 @@ double WalkBank::maxLogPosterior() const {
   return top;
 }
 
-double WalkBank::weight(int member) const {
-  if (member < 0 || member >= members()) return 0.0;
+double WalkBank::posteriorWeights(std::array<double, kMax>* w) const {
   const double top = maxLogPosterior();
   double sum = 0.0;
-  for (int k = 0; k < members(); ++k) sum += std::exp(logPosterior(k) - top);
-  return std::exp(logPosterior(member) - top) / sum;
+  for (int k = 0; k < members(); ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    (*w)[i] = std::exp(logPosterior(k) - top);
+    sum += (*w)[i];
+  }
+  return sum;
+}
+
+double WalkBank::weight(int member) const {
+  if (member < 0 || member >= members()) return 0.0;
+  std::array<double, kMax> w;
+  const double sum = posteriorWeights(&w);
+  return w[static_cast<std::size_t>(member)] / sum;
 }
 
 double WalkBank::mean(bool walk_part, bool noise_part) const {
   if (walks_ == 0) return 0.0;
-  const double top = maxLogPosterior();
-  double sum = 0.0;
+  std::array<double, kMax> w;
+  const double sum = posteriorWeights(&w);
   double log_value = 0.0;
   for (int k = 0; k < members(); ++k) {
-    const double w = std::exp(logPosterior(k) - top);
     const double term =
         (walk_part ? log_q_[walkOf(k)] : 0.0) - (noise_part ? log_s_[scaleOf(k)] : 0.0);
-    sum += w;
-    log_value += w * term;
+    log_value += w[static_cast<std::size_t>(k)] * term;
   }
   return std::exp(log_value / sum);
 }
 
 Eigen::Vector2d WalkBank::upBias() const {
   if (biases_ == 1) return Eigen::Vector2d::Zero();
-  const double top = maxLogPosterior();
-  double sum = 0.0;
+  std::array<double, kMax> w;
+  const double sum = posteriorWeights(&w);
   Eigen::Vector2d c = Eigen::Vector2d::Zero();
   for (int k = 0; k < members(); ++k) {
-    const double w = std::exp(logPosterior(k) - top);
-    sum += w;
-    c += w * x_[static_cast<std::size_t>(k)].tail<2>();
+    const auto i = static_cast<std::size_t>(k);
+    c += w[i] * x_[i].tail<2>();
   }
   return c / sum;
 }
@@ -197,15 +204,13 @@ Eigen::Vector2d WalkBank::upBias() const {
 Eigen::Vector2d WalkBank::upBiasSigma() const {
   if (biases_ == 1) return Eigen::Vector2d::Zero();
   const Eigen::Vector2d mean_c = upBias();
-  const double top = maxLogPosterior();
-  double sum = 0.0;
+  std::array<double, kMax> w;
+  const double sum = posteriorWeights(&w);
   Eigen::Vector2d second = Eigen::Vector2d::Zero();  // E[(c - mean)^2] per axis
   for (int k = 0; k < members(); ++k) {
     const auto i = static_cast<std::size_t>(k);
-    const double w = std::exp(logPosterior(k) - top);
     const Eigen::Vector2d d = x_[i].tail<2>() - mean_c;
-    sum += w;
-    second += w * (P_[i].bottomRightCorner<2, 2>().diagonal() + d.cwiseProduct(d));
+    second += w[i] * (P_[i].bottomRightCorner<2, 2>().diagonal() + d.cwiseProduct(d));
   }
   return (second / sum).cwiseSqrt();
 }

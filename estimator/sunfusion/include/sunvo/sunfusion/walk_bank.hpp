@@ -107,6 +107,9 @@ class WalkBank {
   double mean(bool walk_part, bool noise_part) const;
   double logPosterior(int member) const;
   double maxLogPosterior() const;  // over the members, for weights without overflow
+  // Each member's posterior weight, unnormalised (the largest is 1, no overflow); returns their
+  // sum. The one loop behind weight(), the means and the bias's mixture.
+  double posteriorWeights(std::array<double, kMax>* w) const;
   int walks_ = 0;
   int scales_ = 0;
   int biases_ = 1;
