@@ -7,10 +7,13 @@ Reads the ground truth and a pure VO run of one route (KITTI pose files of the s
 own relative translations with a corrected attitude, p_k = p_k-1 + C_w,k-1 t_k-1,k (the fusion
 changes a run's position only through its attitude: re-chaining a fused run's attitude this way
 gives its final position within a few centimetres). It prints:
-  - oracles: VO re-chained with the true attitude, the true tilt only (VO's heading kept) and the
-    true heading only (VO's tilt kept): what perfect absolute attitude is worth on this route;
+  - oracles: VO re-chained with the true attitude, the true tilt only (VO's heading kept), the
+    true heading only (VO's tilt kept) and VO's mean per-frame attitude drift in its camera (in
+    hindsight) taken out: what perfect absolute attitude, or a perfectly known steady drift, is
+    worth on this route;
   - a causal filter on VO's true attitude error e_w (C_w,true = Exp(e_w) C_w,vo), a random walk
-    of q_tilt across the world's up and q_heading about it per frame, fed every --every frames
+    of q_tilt across the world's up and q_heading about it per frame (with --rate-sigma-deg also
+    a steady drift of VO's attitude in its camera as a state), fed every --every frames
     with simulated measurements of the experiment's error models (docs/experiment.md,
     docs/vertical.md): "up" with --vertical-sigma-deg per axis, 10 % turned by 8 deg, half the
     frames without one; a Sun-CNN-like azimuth with --sun-sigma-deg, 10 % uniform outliers,
@@ -101,9 +104,10 @@ class Route:
 
 
 def kalman_update(x, P, h_rows, y, r_var):
-    """x, P updated by the rows h_rows (measurement y, each row's variance r_var): returns the
-    new (x, P) and the innovation's squared Mahalanobis norm, for one or two rows; None where the
-    innovation covariance is not positive definite."""
+    """x, P (n states) updated by the rows h_rows (n entries each; measurement y, each row's
+    variance r_var): returns the new (x, P) and the innovation's squared Mahalanobis norm, for one
+    or two rows; None where the innovation covariance is not positive definite."""
+    n = len(x)
     Ph = [mat_vec(P, h) for h in h_rows]  # P h_i
     m = len(h_rows)
     S = [[dot(h_rows[i], Ph[j]) + (r_var if i == j else 0.0) for j in range(m)] for i in range(m)]
@@ -115,50 +119,82 @@ def kalman_update(x, P, h_rows, y, r_var):
     else:
         Si = [[S[1][1] / det, -S[0][1] / det], [-S[1][0] / det, S[0][0] / det]]
     nis = sum(y[i] * Si[i][j] * y[j] for i in range(m) for j in range(m))
-    # K = P H^T S^-1 (3 x m)
-    K = [[sum(Ph[j][r] * Si[j][i] for j in range(m)) for i in range(m)] for r in range(3)]
-    x_new = [x[r] + sum(K[r][i] * y[i] for i in range(m)) for r in range(3)]
-    P_new = [[P[r][c] - sum(K[r][i] * Ph[i][c] for i in range(m)) for c in range(3)]
-             for r in range(3)]
-    P_new = [[0.5 * (P_new[r][c] + P_new[c][r]) for c in range(3)] for r in range(3)]
+    # K = P H^T S^-1 (n x m)
+    K = [[sum(Ph[j][r] * Si[j][i] for j in range(m)) for i in range(m)] for r in range(n)]
+    x_new = [x[r] + sum(K[r][i] * y[i] for i in range(m)) for r in range(n)]
+    P_new = [[P[r][c] - sum(K[r][i] * Ph[i][c] for i in range(m)) for c in range(n)]
+             for r in range(n)]
+    P_new = [[0.5 * (P_new[r][c] + P_new[c][r]) for c in range(n)] for r in range(n)]
     return x_new, P_new, nis
 
 
-def run_filter(route, q_tilt, q_heading, args, use_up, use_sun, seed):
+def propagate_rate(x, P, G):
+    """One frame of the drift-rate model: e <- e + G b (G = C_w,c of VO's camera: the steady drift
+    b is VO's, in its camera), x = (e, b), P <- F P F^T with F = [[I, G], [0, I]]."""
+    e, b = x[:3], x[3:]
+    x = add(e, mat_vec(G, b)) + b
+    Pee = [row[:3] for row in P[:3]]
+    Peb = [row[3:] for row in P[:3]]
+    Pbb = [row[3:] for row in P[3:]]
+    GPbb = mat_mul(G, Pbb)
+    GPbe = mat_mul(G, transpose(Peb))
+    new_ee = [[Pee[i][j] + GPbe[i][j] + GPbe[j][i] + dot(GPbb[i], G[j]) for j in range(3)]
+              for i in range(3)]
+    new_eb = [[Peb[i][j] + GPbb[i][j] for j in range(3)] for i in range(3)]
+    P = [new_ee[i] + new_eb[i] for i in range(3)] + \
+        [[new_eb[j][i] for j in range(3)] + Pbb[i] for i in range(3)]
+    return x, P
+
+
+def run_filter(route, q_tilt, q_heading, args, use_up, use_sun, seed, rate_sigma=0.0):
+    """The causal filter over the route; rate_sigma > 0 (deg/frame) adds a steady drift of VO's
+    attitude in its camera, b, to the state (prior N(0, rate_sigma^2) per axis, a walk of
+    --q-rate-deg per frame): e_k = e_k-1 + C_w,c,k b, so that the correction keeps moving between
+    measurements the way VO's error does."""
     rng = random.Random(seed)
     u = route.up
-    Q = [[(q_tilt * DEG) ** 2 * ((1.0 if i == j else 0.0) - u[i] * u[j]) +
-          (q_heading * DEG) ** 2 * u[i] * u[j] for j in range(3)] for i in range(3)]
+    n = 6 if rate_sigma > 0.0 else 3
+    Q = [[0.0] * n for _ in range(n)]
+    for i in range(3):
+        for j in range(3):
+            Q[i][j] = ((q_tilt * DEG) ** 2 * ((1.0 if i == j else 0.0) - u[i] * u[j]) +
+                       (q_heading * DEG) ** 2 * u[i] * u[j])
+    for i in range(3, n):
+        Q[i][i] = (args.q_rate_deg * DEG) ** 2
     a = cross(u, [1.0, 0.0, 0.0]) if abs(u[0]) < 0.9 else cross(u, [0.0, 0.0, 1.0])
     a = scale(a, 1.0 / norm(a))
-    h_up = [a, cross(u, a)]
+    pad = [0.0] * (n - 3)
+    h_up = [a + pad, cross(u, a) + pad]
     s0 = (args.initial_sigma_deg * DEG) ** 2
-    P = [[s0 if i == j else 0.0 for j in range(3)] for i in range(3)]
-    x = [0.0, 0.0, 0.0]
+    P = [[(s0 if i < 3 else (rate_sigma * DEG) ** 2) if i == j else 0.0 for j in range(n)]
+         for i in range(n)]
+    x = [0.0] * n
     out = [[0.0, 0.0, 0.0]]
     for k in range(1, route.n):
-        P = [[P[i][j] + Q[i][j] for j in range(3)] for i in range(3)]
+        if n == 6:
+            x, P = propagate_rate(x, P, route.vo[k][0])
+        P = [[P[i][j] + Q[i][j] for j in range(n)] for i in range(n)]
         if k % args.every == 0:
             # every variate is drawn each time, so that the two sources' sequences do not interact
             v_drop, v_out, v_ang = rng.random(), rng.random(), rng.uniform(0.0, 2.0 * math.pi)
             v_noise = [rng.gauss(0.0, args.vertical_sigma_deg * DEG) for _ in range(2)]
             s_out, s_uniform = rng.random(), rng.uniform(-math.pi, math.pi)
             s_noise = rng.gauss(0.0, args.sun_sigma_deg * DEG)
-            left = sub(route.err[k], x)
+            left = sub(route.err[k], x[:3])
             if use_up and v_drop >= 0.5:
-                n = v_noise if v_out >= 0.1 else [8 * DEG * math.cos(v_ang), 8 * DEG * math.sin(v_ang)]
-                y = [dot(h, left) + n[i] for i, h in enumerate(h_up)]
+                nv = v_noise if v_out >= 0.1 else [8 * DEG * math.cos(v_ang), 8 * DEG * math.sin(v_ang)]
+                y = [dot(h[:3], left) + nv[i] for i, h in enumerate(h_up)]
                 update = kalman_update(x, P, h_up, y, (args.vertical_sigma_deg * DEG) ** 2)
                 if update is not None and update[2] < 16.3:
                     x, P = update[0], update[1]
-                    left = sub(route.err[k], x)
+                    left = sub(route.err[k], x[:3])
             if use_sun:
-                h = [row[1] for row in route.vo[k][0]]  # the camera's y axis in the world
-                y = dot(h, left) + (s_noise if s_out >= 0.1 else s_uniform)
+                h = [row[1] for row in route.vo[k][0]] + pad  # the camera's y axis in the world
+                y = dot(h[:3], left) + (s_noise if s_out >= 0.1 else s_uniform)
                 update = kalman_update(x, P, [h], [y], (args.sun_reported_deg * DEG) ** 2)
                 if update is not None and abs(y) < 45.6 * DEG and update[2] < 16.3:
                     x, P = update[0], update[1]
-        out.append(x)
+        out.append(x[:3])
     return route.metrics(out)
 
 
@@ -177,6 +213,13 @@ def main():
                         help="grid of the tilt walk, deg/frame")
     parser.add_argument("--q-heading", default="0.002,0.005,0.01,0.02,0.05,0.1,0.2",
                         help="grid of the heading walk, deg/frame")
+    parser.add_argument("--rate-sigma-deg", default="0",
+                        help="grid of the prior sigma of a steady drift of VO's attitude in its "
+                        "camera, deg/frame, a state of the filter (0: none)")
+    parser.add_argument("--q-rate-deg", type=float, default=0.0,
+                        help="random walk of that drift, deg/frame per frame")
+    parser.add_argument("--sources", default="up,sun,up+sun",
+                        help="which of the filters to run: up, sun, up+sun")
     args = parser.parse_args()
     route = Route(args.gt, args.vo, [float(v) for v in args.up.split(",")])
     zero = [[0.0, 0.0, 0.0]] * route.n
@@ -193,29 +236,45 @@ def main():
     print(f"  oracle, true attitude:     {change(*route.metrics(route.err))}")
     print(f"  oracle, true tilt only:    {change(*route.metrics(tilt))}")
     print(f"  oracle, true heading only: {change(*route.metrics(heading))}")
+    # VO's steady drift in hindsight: the mean per-frame change of its attitude error in its camera
+    # (e_k - e_k-1 = C_w,c,k rho), taken out from the first frame on
+    rate = [0.0, 0.0, 0.0]
+    for k in range(1, route.n):
+        step = mat_vec(transpose(route.vo[k][0]), sub(route.err[k], route.err[k - 1]))
+        rate = add(rate, scale(step, 1.0 / (route.n - 1)))
+    steady = [[0.0, 0.0, 0.0]]
+    for k in range(1, route.n):
+        steady.append(add(steady[-1], mat_vec(route.vo[k][0], rate)))
+    print(f"  oracle, VO's mean rate ({', '.join(f'{v / DEG:+.4f}' for v in rate)} deg/frame in "
+          f"the camera) taken out: {change(*route.metrics(steady))}")
     q_tilts = [float(v) for v in args.q_tilt.split(",")]
     q_headings = [float(v) for v in args.q_heading.split(",")]
+    rates = [float(v) for v in args.rate_sigma_deg.split(",")]
+    wanted = args.sources.split(",")
     for name, use_up, use_sun in (("up", True, False), ("sun", False, True), ("up + sun", True, True)):
+        if name.replace(" ", "") not in wanted:
+            continue
         cells = []
         for qt in q_tilts:
             for qh in (q_headings if use_sun else [min(q_headings)]):
-                runs = [run_filter(route, qt, qh, args, use_up, use_sun, s)
-                        for s in range(1, args.seeds + 1)]
-                drift = sum(r[0] for r in runs) / len(runs)
-                spread = math.sqrt(sum((r[0] - drift) ** 2 for r in runs) / len(runs))
-                rot = sum(r[1] for r in runs) / len(runs)
-                cells.append((drift, spread, rot, qt, qh))
+                for rate in rates:
+                    runs = [run_filter(route, qt, qh, args, use_up, use_sun, s, rate)
+                            for s in range(1, args.seeds + 1)]
+                    drift = sum(r[0] for r in runs) / len(runs)
+                    spread = math.sqrt(sum((r[0] - drift) ** 2 for r in runs) / len(runs))
+                    rot = sum(r[1] for r in runs) / len(runs)
+                    cells.append((drift, spread, rot, qt, qh, rate))
         best = min(cells)
         best_rot = min(cells, key=lambda c: c[2])
         # the cell whose smaller gain is largest: what a target on both numbers can get
         best_both = min(cells, key=lambda c: max(c[0] / base[0], c[2] / base[1]))
-        print(f"  {name:8s} best drift:    q_tilt {best[3]:5.3f} q_heading {best[4]:5.3f} deg/frame: "
-              f"{change(best[0], best[2])}, drift std over the draws {best[1]:.2f} m")
-        print(f"  {name:8s} best rotation: q_tilt {best_rot[3]:5.3f} q_heading {best_rot[4]:5.3f} "
-              f"deg/frame: {change(best_rot[0], best_rot[2])}")
-        print(f"  {name:8s} best both:     q_tilt {best_both[3]:5.3f} q_heading {best_both[4]:5.3f} "
-              f"deg/frame: {change(best_both[0], best_both[2])}")
 
+        def cell(c):
+            rate = f" rate {c[5]:5.3f}" if len(rates) > 1 or c[5] > 0.0 else ""
+            return f"q_tilt {c[3]:5.3f} q_heading {c[4]:5.3f}{rate} deg/frame: {change(c[0], c[2])}"
+        print(f"  {name:8s} best drift:    {cell(best)}, drift std over the draws {best[1]:.2f} m")
+        print(f"  {name:8s} best rotation: {cell(best_rot)}")
+        print(f"  {name:8s} best both:     {cell(best_both)}")
 
 if __name__ == "__main__":
     main()
