@@ -219,7 +219,7 @@ def main():
     parser.add_argument("--q-rate-deg", type=float, default=0.0,
                         help="random walk of that drift, deg/frame per frame")
     parser.add_argument("--sources", default="up,sun,up+sun",
-                        help="which of the filters to run: up, sun, up+sun")
+                        help="which of the filters to run: up, sun, up+sun (none: the oracles only)")
     args = parser.parse_args()
     route = Route(args.gt, args.vo, [float(v) for v in args.up.split(",")])
     zero = [[0.0, 0.0, 0.0]] * route.n

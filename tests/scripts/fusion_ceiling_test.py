@@ -103,6 +103,8 @@ class FusionCeiling(unittest.TestCase):
             _, walk_change = drift_of("up       best drift", walk.stdout)
             _, rate_change = drift_of("up       best drift", rate.stdout)
             self.assertIn("rate 0.050", rate.stdout)
+            # the drift known in hindsight, taken out from the first frame, is all of the error
+            self.assertEqual(drift_of("oracle, VO's mean rate", rate.stdout), (0.0, -100))
             # a 0.002 deg/frame walk lags a 0.02 deg/frame drift (measured -7 %); the rate state
             # learns it (-72 %)
             self.assertGreaterEqual(walk_change, -20)

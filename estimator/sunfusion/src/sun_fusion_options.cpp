@@ -118,12 +118,6 @@ Status SunFusionOptions::validate() const {
   if (!(vertical_bias_length_frames >= 1.0 && vertical_bias_length_frames <= 1e7)) {
     return invalidArgument("fusion.vertical_bias_length_frames out of range [1, 1e7]");
   }
-  if (!(attitude_rate_sigma_deg >= 0.0 && attitude_rate_sigma_deg <= 0.5)) {
-    return invalidArgument("fusion.attitude_rate_sigma_deg out of range [0, 0.5]");
-  }
-  if (!(attitude_rate_length_frames >= 1.0 && attitude_rate_length_frames <= 1e7)) {
-    return invalidArgument("fusion.attitude_rate_length_frames out of range [1, 1e7]");
-  }
   return Status::ok();
 }
 

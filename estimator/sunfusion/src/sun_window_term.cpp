@@ -47,11 +47,6 @@ Status SunWindowTerm::init(const SunFusionOptions& options) {
     active_[static_cast<std::size_t>(num_active_++)] = kUpBias;
     active_[static_cast<std::size_t>(num_active_++)] = kUpBias + 1;
   }
-  if (rateEnabled()) {
-    Pa_.block<3, 3>(kRate, kRate) =
-        Eigen::Matrix3d::Identity() * std::pow(options.attitude_rate_sigma_deg * kDeg, 2);
-  }
-  rate_.setZero();
   bias_ = 0.0;
   bias_delta_ = 0.0;
   up_bias_.setZero();
@@ -164,14 +159,7 @@ Status SunWindowTerm::onSolve(backend::BundleWindow& window) {
   const bool estimate = options_.estimate_base_attitude;
   const std::uint64_t newest = window.sequence(window.size() - 1);
   if (estimate && last_sequence_ && newest > *last_sequence_) {
-    const Eigen::Matrix3d C_w_c =
-        window.T_w_b().linear() * window.T_k_b(window.size() - 1).linear().transpose();
-    const Eigen::Vector3d step_w = propagate(static_cast<double>(newest - *last_sequence_), C_w_c);
-    if (!step_w.isZero(0.0) && step_w.allFinite()) {
-      // The drift the rate state predicts for these frames, taken out of the base as it comes.
-      window.correctBaseAttitude(expSO3(window.T_w_b().linear().transpose() * step_w));
-      noteCorrection(step_w);
-    }
+    propagate(static_cast<double>(newest - *last_sequence_));
   }
   last_sequence_ = newest;
   delta_ = {0.0, 0.0, 0.0};
@@ -346,13 +334,6 @@ void SunWindowTerm::onSolved(backend::BundleWindow& window) {
     return;
   }
   const Eigen::Matrix3d C_w_b = window.T_w_b().linear();
-  // The solve's correction of the active state in the world frame (the rate state's update).
-  ActiveVector dx = ActiveVector::Zero(n);
-  dx.head<3>() = C_w_b * delta_b;
-  if (n > 3) {
-    dx(3) = biasEnabled() ? db : dc.x();
-    if (n > 4) dx.tail<2>() = dc;
-  }
   if (n > 3) {
     // The same update over the augmented state: T = diag(C_w_b, I) takes the information to the
     // world.
@@ -364,7 +345,6 @@ void SunWindowTerm::onSolved(backend::BundleWindow& window) {
     ActiveMatrix P_new = Pn - Pn * M * Pn;
     P_new = 0.5 * (P_new + P_new.transpose());
     if (!P_new.allFinite() || !(P_new.diagonal().bottomRows(n - 3).minCoeff() >= 0.0)) return;
-    if (rateEnabled()) updateRate(Pn, M, dx);
     setActiveCovariance(P_new);
     bias_ += db;
     up_bias_ += dc;
@@ -378,14 +358,20 @@ void SunWindowTerm::onSolved(backend::BundleWindow& window) {
     Eigen::Matrix3d P_new = P_old - P_old * M * P_old;
     P_new = 0.5 * (P_new + P_new.transpose());
     if (!P_new.allFinite()) return;
-    if (rateEnabled()) updateRate(ActiveMatrix(P_old), ActiveMatrix(M), dx);
     P() = P_new;
   }
   window.correctBaseAttitude(expSO3(delta_b));
   const Eigen::Vector3d c_w = C_w_b * delta_b;
-  noteCorrection(c_w);
+  // The answers collected for the start's tilt were carried by the attitude just corrected.
+  if (options_.levelsStartTilt() && !start_decided_) world_up_.turn(expSO3(c_w));
   last_correction_ = {window.sequence(window.size() - 1), c_w, used};
   ++num_corrections_;
+  // The evidence sums describe the error left: each innovation r_i ~ H_i e becomes H_i (e - c_w).
+  if (options_.drift_adaptation == DriftAdaptation::kEvidence) {
+    persistence_g_ -= persistence_I_ * c_w;
+  }
+  if (tiltByEvidence()) vertical_g_ -= vertical_I_ * c_w;
+  if (tiltByLikelihood()) tilt_bank_.shift(c_w);
 }
 
 std::optional<Eigen::Vector3d> SunWindowTerm::takeStartLevelling(std::uint64_t sequence) {
@@ -408,10 +394,9 @@ std::optional<Eigen::Vector3d> SunWindowTerm::takeStartLevelling(std::uint64_t s
   const Eigen::Matrix3d uu = u * u.transpose();
   const double s2 = sigma * sigma;
   P() = uu * P() * uu + s2 * (Eigen::Matrix3d::Identity() - uu);
-  const Eigen::Matrix<double, 3, kAugmented - 3> P_cross =
-      uu * Pa_.topRightCorner<3, kAugmented - 3>();
-  Pa_.topRightCorner<3, kAugmented - 3>() = P_cross;
-  Pa_.bottomLeftCorner<kAugmented - 3, 3>() = P_cross.transpose();
+  const Eigen::Matrix<double, 3, 3> P_tbias = uu * Pa_.topRightCorner<3, 3>();
+  Pa_.topRightCorner<3, 3>() = P_tbias;
+  Pa_.bottomLeftCorner<3, 3>() = P_tbias.transpose();
   if (tiltByLikelihood()) tilt_bank_.shift(e);
   last_correction_ = {sequence, e, world_up_.used()};
   ++num_corrections_;
@@ -421,6 +406,40 @@ std::optional<Eigen::Vector3d> SunWindowTerm::takeStartLevelling(std::uint64_t s
 bool SunWindowTerm::splitByGravity() const {
   return options_.split_drift_by_gravity &&
          options_.drift_adaptation == DriftAdaptation::kPersistence;
+}
+
+void SunWindowTerm::propagate(double frames) {
+  if (biasEnabled() || upBiasEnabled()) {
+    // Gauss-Markov: each bias estimate and its covariances decay by its phi, its variance relaxes
+    // to its sigma^2 (a bias that is not a state keeps zero rows).
+    const double phi_b = std::exp(-frames / options_.sun_bias_length_frames);
+    const double phi_c = std::exp(-frames / options_.vertical_bias_length_frames);
+    Eigen::Matrix<double, kAugmented, 1> phi;
+    phi << 1.0, 1.0, 1.0, phi_b, phi_c, phi_c;
+    bias_ *= phi_b;
+    up_bias_ *= phi_c;
+    Pa_ = phi.asDiagonal() * Pa_ * phi.asDiagonal();
+    if (biasEnabled()) {
+      const double sigma_b = options_.sun_bias_sigma_deg * kDeg;
+      Pa_(kSunBias, kSunBias) += (1.0 - phi_b * phi_b) * sigma_b * sigma_b;
+    }
+    if (upBiasEnabled()) {
+      const double sigma_c = options_.vertical_bias_sigma_deg * kDeg;
+      for (int i = kUpBias; i < kUpBias + 2; ++i)
+        Pa_(i, i) += (1.0 - phi_c * phi_c) * sigma_c * sigma_c;
+    }
+  }
+  if (tiltByLikelihood()) tilt_bank_.propagate(frames, worldUp());
+  const double q = drift_deg_per_frame_ * kDeg;
+  if (!splitByGravity() || heading_drift_deg_per_frame_ == drift_deg_per_frame_) {
+    P() += Eigen::Matrix3d::Identity() * q * q * frames;
+    return;
+  }
+  // Tilt (the plane normal to the world's up) and heading (about it) walk apart.
+  const Eigen::Vector3d& u = worldUp();
+  const double qh = heading_drift_deg_per_frame_ * kDeg;
+  const Eigen::Matrix3d uu = u * u.transpose();
+  P() += (q * q * (Eigen::Matrix3d::Identity() - uu) + qh * qh * uu) * frames;
 }
 
 bool SunWindowTerm::evaluateAt(const ceres::CostFunction& cost, const Isometry3& T_k_b,

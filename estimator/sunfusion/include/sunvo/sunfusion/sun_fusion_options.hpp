@@ -173,14 +173,6 @@ struct SunFusionOptions {
   double vertical_bias_sigma_deg = 0.0;
   // Its correlation length, frames, [1, 1e7].
   double vertical_bias_length_frames = 2500.0;
-  // VO's steady attitude drift (header comment, "A steady drift"): a rate rho of the world
-  // attitude error per frame, fixed in the camera's axes, as a state beside the attitude; its
-  // estimate turns VO's attitude every frame. Stationary std, deg/frame, [0, 0.5]; 0 = no such
-  // state (the error is a random walk only). Only with estimate_base_attitude.
-  double attitude_rate_sigma_deg = 0.0;
-  // Its correlation length, frames, [1, 1e7]: Gauss-Markov, rho <- phi rho, phi = exp(-1/length)
-  // per frame (a rig's miscalibration changes over minutes to hours).
-  double attitude_rate_length_frames = 5000.0;
 
   // Whether the first answers level the start (kStartTilt with frames to take them from).
   bool levelsStartTilt() const {
@@ -227,8 +219,6 @@ struct SunFusionOptions {
     v("sun_bias_length_frames", s.sun_bias_length_frames);
     v("vertical_bias_sigma_deg", s.vertical_bias_sigma_deg);
     v("vertical_bias_length_frames", s.vertical_bias_length_frames);
-    v("attitude_rate_sigma_deg", s.attitude_rate_sigma_deg);
-    v("attitude_rate_length_frames", s.attitude_rate_length_frames);
   }
 };
 

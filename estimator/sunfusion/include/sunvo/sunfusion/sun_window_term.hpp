@@ -96,27 +96,6 @@
 //    heading and the bias not. On a straight drive the two are one, and the prior splits them.
 //    The augmented state (dtheta_w, b, c) has one covariance (rows of a bias that is not a state
 //    are zero) and the same joint prior and information update.
-//  - A steady drift (attitude_rate_sigma_deg > 0): on the real 0020 tracks VO's attitude error
-//    grows mostly by the same small rotation every frame, fixed in the camera's axes (mean
-//    -0.009 / -0.006 / +0.015 deg per frame against a spread of 0.08-0.17, docs/experiment.md), as
-//    a rig's miscalibration makes it. A random walk describes that only with a q so large that a
-//    noisy source pulls the attitude around, and a walk trails the drift between answers. The rate
-//    rho (rad per frame, camera axes) is then a state: over `frames` frames with the newest
-//    camera's attitude C_w_c,
-//      dtheta_w <- dtheta_w + frames C_w_c rho,
-//    i.e. P_a <- F P_a F^T with F the identity but for the block frames C_w_c from rho to dtheta_w,
-//    and rho is Gauss-Markov like the biases (attitude_rate_length_frames). The estimate of rho
-//    turns VO's base attitude by frames C_w_c rho_hat at every solve (the error the model predicts
-//    is taken out as it comes, and every filter that tracks the error left, the walk bank, the
-//    evidence sums and the start's alignment, is told of it as of a correction). No residual acts
-//    on rho: an answer informs it through its covariance with dtheta_w alone, so the solve keeps
-//    the active state's prior (rho's marginal is not needed in it), and afterwards, with x_a the
-//    active state (world frame), P_aa its prior, dx_a the solve's correction and M = (I + A
-//    P_aa)^-1 A as below (A: the answers' information),
-//      rho <- rho + P_ra P_aa^-1 dx_a,  P_rr <- P_rr - P_ra M P_ar,  P_ar <- P_ar - P_aa M P_ar
-//    (the Kalman update of the augmented state whose measurement rows on rho are zero). Which
-//    frame rho lives in matters: VO's per-frame error of a rig with a turned right camera is fixed
-//    in the camera, so the world-frame rate turns with the route, which the model follows.
 //
 // A second channel of the same form: the camera's "up" measured from the images (the vertical
 // vanishing point, estimator/vertical) is a known world direction (world_up) seen in camera k,
@@ -236,12 +215,6 @@ class SunWindowTerm {
                ? tilt_bank_.upBiasSigma()
                : Eigen::Vector2d(Pa_.diagonal().segment<2>(kUpBias).cwiseMax(0.0).cwiseSqrt());
   }
-  // VO's steady attitude drift (attitude_rate_sigma_deg > 0): its estimate in the camera's axes
-  // and the std per axis, rad per frame (0 without the state).
-  const Eigen::Vector3d& attitudeRate() const { return rate_; }
-  Eigen::Vector3d attitudeRateSigma() const {
-    return Pa_.diagonal().segment<3>(kRate).cwiseMax(0.0).cwiseSqrt();
-  }
 
  private:
   struct Pending {
@@ -266,14 +239,8 @@ class SunWindowTerm {
                                   const SunMeasurement& m);
   Status onSolve(backend::BundleWindow& window);
   void onSolved(backend::BundleWindow& window);
-  // Covariance propagation over `frames` new frames (C_w_c: the newest camera's attitude); returns
-  // the turn of the world attitude the rate state predicts for them (zero without it), which the
-  // caller applies to the base (sun_window_rate.cpp).
-  Eigen::Vector3d propagate(double frames, const Eigen::Matrix3d& C_w_c);
-  // What the estimate's correction by the world rotation vector c_w means to the filters that track
-  // the error left: the evidence sums, the walk bank and the start's alignment.
-  void noteCorrection(const Eigen::Vector3d& c_w);
-
+  // Covariance propagation over `frames` new frames.
+  void propagate(double frames);
   // The Jacobian of a cost's whitened residual wrt its bias block: m rows, 1 (the sun's azimuth)
   // or 2 (the up's turn) columns; 0 columns for a cost without one.
   using BiasJacobian = Eigen::Matrix<double, 3, 2, Eigen::RowMajor>;
@@ -289,23 +256,15 @@ class SunWindowTerm {
   bool upBiasEnabled() const {
     return options_.vertical_bias_sigma_deg > 0.0 && options_.estimate_base_attitude;
   }
-  bool rateEnabled() const {
-    return options_.attitude_rate_sigma_deg > 0.0 && options_.estimate_base_attitude;
-  }
   // The walk bank estimates the cue's bias, which is taken out of its answers (two-stage).
   bool bankUpBias() const { return tiltByLikelihood() && tilt_bank_.hasUpBias(); }
-  // The augmented state (dtheta_w, b, c, rho) in Pa_'s rows, and the active rows (those of a
-  // solve): 3 + 1 with the sun's bias + 2 with the up's, in that order; rho is never active.
+  // The augmented state (dtheta_w, b, c) in Pa_'s rows, and the active rows: 3 + 1 with the sun's
+  // bias + 2 with the up's, in that order.
   static constexpr int kSunBias = 3;
   static constexpr int kUpBias = 4;
-  static constexpr int kRate = 6;
-  static constexpr int kAugmented = 9;
+  static constexpr int kAugmented = 6;
   using AugmentedMatrix = Eigen::Matrix<double, kAugmented, kAugmented>;
   using ActiveMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>;
-  using ActiveVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1>;
-  // The rate state's share of a solve's update (header comment): Pn the active state's prior and
-  // M = (I + A Pn)^-1 A in the world frame, dx the solve's correction of the active state there.
-  void updateRate(const ActiveMatrix& Pn, const ActiveMatrix& M, const ActiveVector& dx);
   // The active rows and columns of Pa_, the attitude's turned by C (C_b_w: the base frame).
   ActiveMatrix activeCovariance(const Eigen::Matrix3d& C) const;
   // Writes an active covariance in the world frame back into Pa_.
@@ -382,7 +341,7 @@ class SunWindowTerm {
   std::optional<GateResult> last_decision_;
   // Base-attitude mode state.
   std::array<double, 3> delta_{0.0, 0.0, 0.0};  // delta_b of the current solve
-  // Covariance of (dtheta_w (world frame), b, c, rho), rad^2; rows of a state off are zero.
+  // Covariance of (dtheta_w (world frame), b, c), rad^2; rows of a bias off are zero.
   AugmentedMatrix Pa_ = AugmentedMatrix::Zero();
   auto P() { return Pa_.topLeftCorner<3, 3>(); }  // of dtheta_w
   std::array<int, kAugmented> active_{};          // Pa_'s active rows
@@ -393,7 +352,6 @@ class SunWindowTerm {
   double bias_delta_ = 0.0;
   Eigen::Vector2d up_bias_ = Eigen::Vector2d::Zero();
   std::array<double, 2> up_bias_delta_{0.0, 0.0};
-  Eigen::Vector3d rate_ = Eigen::Vector3d::Zero();  // rho, camera axes, rad per frame
   double drift_deg_per_frame_ = 0.0;          // q_theta in use (the tilt's when split), deg/frame
   double heading_drift_deg_per_frame_ = 0.0;  // the heading's q_theta when split, deg/frame
   Eigen::Vector3d persistence_g_ = Eigen::Vector3d::Zero();  // forgotten sum of H^T w r

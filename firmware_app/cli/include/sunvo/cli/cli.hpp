@@ -118,8 +118,7 @@ inline void addBiasStateOptions(CLI::App& app, double& sigma_deg, double& length
 
 // The fusion's bias states (sunfusion::SunFusionOptions), the same in every program that runs the
 // fusion: the sun's azimuth bias (docs/fusion_bias.md) as --bias-state-deg, --bias-state-frames,
-// the vertical cue's (docs/fusion_bias.md) as --up-bias-state-deg, --up-bias-state-frames, and
-// VO's steady attitude drift (docs/experiment.md) as --rate-state-deg, --rate-state-frames.
+// and the vertical cue's (docs/fusion_bias.md) as --up-bias-state-deg, --up-bias-state-frames.
 template <class FusionOptions>
 void addBiasStateOptions(CLI::App& app, FusionOptions& fusion) {
   addBiasStateOptions(app, fusion.sun_bias_sigma_deg, fusion.sun_bias_length_frames, "",
@@ -130,13 +129,6 @@ void addBiasStateOptions(CLI::App& app, FusionOptions& fusion) {
                       "the fusion's bias state of the vertical cue (a turn of its up about the "
                       "camera's x and z axes): its std, deg (0 = none)",
                       10.0, 1e7);
-  app.add_option("--rate-state-deg", fusion.attitude_rate_sigma_deg,
-                 "the fusion's state of VO's steady attitude drift (a rate in the camera's axes): "
-                 "its std, deg/frame (0 = none)")
-      ->check(CLI::Range(0.0, 0.5));
-  app.add_option("--rate-state-frames", fusion.attitude_rate_length_frames,
-                 "its correlation length, frames")
-      ->check(CLI::Range(1.0, 1e7));
 }
 
 // The ranges the likelihood rule chooses the tilt's walk from (sunfusion::SunFusionOptions,
