@@ -65,7 +65,8 @@ Status SunFusionOptions::validate() const {
   if (!(evidence_sigmas > 0.0 && evidence_sigmas <= 100.0)) {
     return invalidArgument("fusion.evidence_sigmas out of range (0, 100]");
   }
-  if (vertical_drift_adaptation == VerticalDriftAdaptation::kLikelihood) {
+  if (vertical_drift_adaptation == VerticalDriftAdaptation::kLikelihood ||
+      heading_drift_adaptation == HeadingDriftAdaptation::kLikelihood) {
     if (likelihood_walks < 2 || likelihood_walks > WalkBank::kMaxWalks) {
       return invalidArgument("fusion.likelihood_walks out of range [2, 8]");
     }
@@ -93,8 +94,8 @@ Status SunFusionOptions::validate() const {
     }
     if (!(min_drift_deg_per_frame > 0.0)) {
       return invalidArgument(
-          "fusion.min_drift_deg_per_frame must be > 0 with vertical_drift_adaptation likelihood "
-          "(the bank's slowest walk)");
+          "fusion.min_drift_deg_per_frame must be > 0 with vertical_drift_adaptation or "
+          "heading_drift_adaptation likelihood (the bank's slowest walk)");
     }
   }
   if (!(evidence_forgetting > 0.0 && evidence_forgetting < 1.0)) {

@@ -68,23 +68,10 @@ void SunWindowTerm::adaptDrift(const Innovation& inn, const Eigen::Matrix3d& C_w
           // capped as in the sums. With a bias axis the bank sees the answer as it came: the
           // innovation at c = 0 is r + J_up c_removed (J_up = d r / d c).
           vertical_in_sums_ = true;
-          Eigen::Matrix3d H = errorJacobian(inn.J, C_w_b);
-          Eigen::Vector3d r_as_came = huberWeight(inn) * (inn.r + inn.J_up * inn.up_bias_removed);
-          Eigen::Matrix<double, 3, 2> H_c = inn.J_up;
-          int rows = inn.dof;
-          if (inn.radial.squaredNorm() > 0.0) {
-            // The rows of a 3-D direction's residual across the measured direction only: its
-            // radial row is zero to first order, and read as a row of noise it would make the
-            // noise scales read sqrt(2/3) of the cue's true noise (the whitened residual's radial
-            // direction is the measured one, W s = s / sigma).
-            const Eigen::Vector3d t1 = inn.radial.unitOrthogonal();
-            Eigen::Matrix3d Q;
-            Q << t1, inn.radial.cross(t1), inn.radial;
-            H = Q.transpose() * H;
-            r_as_came = Q.transpose() * r_as_came;
-            H_c = Q.transpose() * H_c;
-            rows = 2;
-          }
+          Eigen::Matrix3d H;
+          Eigen::Vector3d r_as_came;
+          Eigen::Matrix<double, 3, 2> H_c;
+          const int rows = bankAnswer(inn, C_w_b, &H, &r_as_came, &H_c);
           tilt_bank_.update(H, H_c, r_as_came, rows);
           drift_deg_per_frame_ =
               std::clamp(tilt_bank_.walk() / kDeg, options_.min_drift_deg_per_frame,
@@ -111,6 +98,23 @@ void SunWindowTerm::adaptDrift(const Innovation& inn, const Eigen::Matrix3d& C_w
                                     : -options_.persistence_step_down;
           heading_drift_deg_per_frame_ =
               clampDrift(heading_drift_deg_per_frame_ * std::exp(step_h));
+          if (headingByLikelihood()) {
+            // The heading's walk the sun's innovations make most likely, as the tilt's above. The
+            // bank is fed from the first answer but chooses the walk only once the cue takes the
+            // tilt: before that the tilt's error in the sun's innovations fires the persistence
+            // test, which then holds both walks up (docs/vertical.md, "the heading's walk"), and
+            // the bank, whose members take the tilt's walk as given, would read it as heading.
+            Eigen::Matrix3d H;
+            Eigen::Vector3d r;
+            Eigen::Matrix<double, 3, 2> H_c;
+            const int rows = bankAnswer(inn, C_w_b, &H, &r, &H_c);
+            heading_bank_.update(H, r, rows);
+            if (vertical_in_sums_) {
+              heading_drift_deg_per_frame_ =
+                  std::clamp(heading_bank_.walk() / kDeg, options_.min_drift_deg_per_frame,
+                             options_.max_drift_deg_per_frame);
+            }
+          }
         }
         return;
       }
@@ -138,6 +142,31 @@ bool SunWindowTerm::tiltByEvidence() const {
 bool SunWindowTerm::tiltByLikelihood() const {
   return splitByGravity() &&
          options_.vertical_drift_adaptation == VerticalDriftAdaptation::kLikelihood;
+}
+
+bool SunWindowTerm::headingByLikelihood() const {
+  return splitByGravity() &&
+         options_.heading_drift_adaptation == HeadingDriftAdaptation::kLikelihood;
+}
+
+int SunWindowTerm::bankAnswer(const Innovation& inn, const Eigen::Matrix3d& C_w_b,
+                              Eigen::Matrix3d* H, Eigen::Vector3d* r,
+                              Eigen::Matrix<double, 3, 2>* H_c) const {
+  // With the cue's bias axis the bank sees the answer as it came: the innovation at c = 0 is
+  // r + J_up c_removed (J_up = d r / d c; zero for the sun's answers).
+  *H = errorJacobian(inn.J, C_w_b);
+  *r = huberWeight(inn) * (inn.r + inn.J_up * inn.up_bias_removed);
+  *H_c = inn.J_up;
+  if (inn.radial.squaredNorm() == 0.0) return inn.dof;
+  // The rows across the measured direction (the whitened residual's radial direction is the
+  // measured one, W s = s / sigma).
+  const Eigen::Vector3d t1 = inn.radial.unitOrthogonal();
+  Eigen::Matrix3d Q;
+  Q << t1, inn.radial.cross(t1), inn.radial;
+  *H = Q.transpose() * *H;
+  *r = Q.transpose() * *r;
+  *H_c = Q.transpose() * *H_c;
+  return 2;
 }
 
 double SunWindowTerm::huberWeight(const Innovation& inn) const {

@@ -20,6 +20,21 @@ using RowsJacobian = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor, 3
 using RowsSquare = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 3, 3>;
 using RowsVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 3, 1>;
 
+// A likelihood rule's walk bank (walk_bank.hpp): walks over [min_drift_deg_per_frame, q_max_deg]
+// (deg/frame), the likelihood_* noise scales and forgetting, every member starting at s0 (rad).
+WalkBankOptions likelihoodBank(const SunFusionOptions& options, double q_max_deg, double s0) {
+  WalkBankOptions bank;
+  bank.q_min_rad = options.min_drift_deg_per_frame * kDeg;
+  bank.q_max_rad = q_max_deg * kDeg;
+  bank.walks = options.likelihood_walks;
+  bank.noise_min = options.likelihood_noise_min;
+  bank.noise_max = options.likelihood_noise_max;
+  bank.noise_scales = options.likelihood_noise_scales;
+  bank.initial_sigma_rad = s0;
+  bank.forgetting = options.likelihood_forgetting;
+  return bank;
+}
+
 }  // namespace
 
 Status SunWindowTerm::init(const SunFusionOptions& options) {
@@ -78,19 +93,16 @@ Status SunWindowTerm::init(const SunFusionOptions& options) {
   num_inflations_ = 0;
   world_up_.reset(static_cast<std::uint64_t>(options.world_up_alignment_frames), options.world_up);
   if (tiltByLikelihood()) {
-    WalkBankOptions bank;
-    bank.q_min_rad = options.min_drift_deg_per_frame * kDeg;
-    bank.q_max_rad = options.vertical_max_drift_deg_per_frame * kDeg;
-    bank.walks = options.likelihood_walks;
-    bank.noise_min = options.likelihood_noise_min;
-    bank.noise_max = options.likelihood_noise_max;
-    bank.noise_scales = options.likelihood_noise_scales;
-    bank.initial_sigma_rad = s0;
-    bank.forgetting = options.likelihood_forgetting;
+    WalkBankOptions bank = likelihoodBank(options, options.vertical_max_drift_deg_per_frame, s0);
     bank.up_bias_scales = options.likelihood_up_bias_scales;
     bank.up_bias_max_rad = options.likelihood_up_bias_max_deg * kDeg;
     bank.up_bias_length_frames = options.vertical_bias_length_frames;
     SUNVO_RETURN_IF_ERROR(tilt_bank_.init(bank));
+  }
+  if (headingByLikelihood()) {
+    WalkBankOptions bank = likelihoodBank(options, options.max_drift_deg_per_frame, s0);
+    bank.heading = true;
+    SUNVO_RETURN_IF_ERROR(heading_bank_.init(bank));
   }
   alignment_gate_ = options.vertical_gate;
   if (options.levelsStartTilt()) {
@@ -372,6 +384,7 @@ void SunWindowTerm::onSolved(backend::BundleWindow& window) {
   }
   if (tiltByEvidence()) vertical_g_ -= vertical_I_ * c_w;
   if (tiltByLikelihood()) tilt_bank_.shift(c_w);
+  if (headingByLikelihood()) heading_bank_.shift(c_w);
 }
 
 std::optional<Eigen::Vector3d> SunWindowTerm::takeStartLevelling(std::uint64_t sequence) {
@@ -398,6 +411,7 @@ std::optional<Eigen::Vector3d> SunWindowTerm::takeStartLevelling(std::uint64_t s
   Pa_.topRightCorner<3, 3>() = P_tbias;
   Pa_.bottomLeftCorner<3, 3>() = P_tbias.transpose();
   if (tiltByLikelihood()) tilt_bank_.shift(e);
+  if (headingByLikelihood()) heading_bank_.shift(e);
   last_correction_ = {sequence, e, world_up_.used()};
   ++num_corrections_;
   return e;
@@ -430,6 +444,9 @@ void SunWindowTerm::propagate(double frames) {
     }
   }
   if (tiltByLikelihood()) tilt_bank_.propagate(frames, worldUp());
+  if (headingByLikelihood()) {
+    heading_bank_.propagate(frames, worldUp(), drift_deg_per_frame_ * kDeg);
+  }
   const double q = drift_deg_per_frame_ * kDeg;
   if (!splitByGravity() || heading_drift_deg_per_frame_ == drift_deg_per_frame_) {
     P() += Eigen::Matrix3d::Identity() * q * q * frames;

@@ -45,6 +45,7 @@ Status WalkBank::init(const WalkBankOptions& o) {
   biases_ = o.up_bias_scales;
   forgetting_ = o.forgetting;
   bias_length_ = o.up_bias_length_frames;
+  heading_ = o.heading;
   logSpaced(o.q_min_rad, o.q_max_rad, walks_, &log_q_);
   logSpaced(o.noise_min, o.noise_max, scales_, &log_s_);
   // 0, then halving down to the widest: 0, max / 4, max / 2, max with four.
@@ -65,13 +66,17 @@ Status WalkBank::init(const WalkBankOptions& o) {
   return Status::ok();
 }
 
-void WalkBank::propagate(double frames, const Eigen::Vector3d& up) {
-  const Eigen::Matrix3d tilt_plane = Eigen::Matrix3d::Identity() - up * up.transpose();
+void WalkBank::propagate(double frames, const Eigen::Vector3d& up, double other_q) {
+  const Eigen::Matrix3d uu = up * up.transpose();
+  const Eigen::Matrix3d tilt_plane = Eigen::Matrix3d::Identity() - uu;
+  const Eigen::Matrix3d& walk_space = heading_ ? uu : tilt_plane;
+  const Eigen::Matrix3d& other_space = heading_ ? tilt_plane : uu;
   const double phi = std::exp(-frames / bias_length_);
   for (int k = 0; k < members(); ++k) {
     const auto i = static_cast<std::size_t>(k);
     const double q = std::exp(log_q_[walkOf(k)]);
-    P_[i].topLeftCorner<3, 3>() += q * q * frames * tilt_plane;
+    P_[i].topLeftCorner<3, 3>() += q * q * frames * walk_space;
+    if (other_q > 0.0) P_[i].topLeftCorner<3, 3>() += other_q * other_q * frames * other_space;
     if (biases_ == 1) continue;
     // Gauss-Markov: c and its covariances decay by phi, its variance relaxes to sigma_l^2.
     const double sigma_c = bias_sigma_[biasOf(k)];

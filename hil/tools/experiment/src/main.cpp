@@ -133,6 +133,9 @@ int main(int argc, char** argv) {
   sunvo::cli::addEnumOption(app, "--vertical-drift-rule", options.fusion.vertical_drift_adaptation,
                             "how the tilt's walk follows the \"up\" (persistence rule, split): "
                             "likelihood (default), persistence or evidence (docs/vertical.md)");
+  sunvo::cli::addEnumOption(app, "--heading-drift-rule", options.fusion.heading_drift_adaptation,
+                            "how the heading's walk follows the sun (split): persistence (default) "
+                            "or likelihood (a walk bank, docs/vertical.md)");
   sunvo::cli::addTiltWalkRangeOptions(app, options.fusion);
   app.add_flag("!--no-split-drift", options.fusion.split_drift_by_gravity,
                "persistence rule: one random walk for all axes (before 2026-11-26), not one for "

@@ -100,6 +100,9 @@ int main(int argc, char** argv) {
       app, "--vertical-drift-rule", options.fusion.vertical_drift_adaptation,
       "how the tilt's walk follows the cue: likelihood (default), persistence or "
       "evidence (docs/vertical.md)");
+  sunvo::cli::addEnumOption(app, "--heading-drift-rule", options.fusion.heading_drift_adaptation,
+                            "how the heading's walk follows the sun: persistence (default) or "
+                            "likelihood (a walk bank, docs/vertical.md)");
   sunvo::cli::addTiltWalkRangeOptions(app, options.fusion);
   app.add_option("--world-up-alignment-frames", options.world_up_alignment_frames,
                  "the cue's answers of the first N frames measure the world's up (-1: 50 when the "

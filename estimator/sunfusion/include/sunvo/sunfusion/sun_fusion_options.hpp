@@ -45,6 +45,21 @@ inline std::span<const std::string_view> enumNames(VerticalDriftAdaptation) {
   return kNames;
 }
 
+// How the heading's walk follows the sun's answers (persistence rule, split by gravity).
+//  kPersistence (default): stepped on the persistence test of the sun's answers alone.
+//  kLikelihood: chosen by a bank of walks in [min_drift_deg_per_frame, max_drift_deg_per_frame]
+//    and noise scales of the sun's sigma (walk_bank.hpp with its walk about world_up), each member
+//    fed the sun's answers, as the tilt's bank is fed the cue's. A source far better than it
+//    reports (the true vector: 0.05 rad for an error of 0) cannot fire the persistence test on a
+//    heading that moves by a fraction of that sigma, and once the cue takes the tilt out of the
+//    sun's innovations nothing else fires it (docs/vertical.md, "Why 00's true vector loses its
+//    gain beside the up").
+enum class HeadingDriftAdaptation { kPersistence, kLikelihood };
+inline std::span<const std::string_view> enumNames(HeadingDriftAdaptation) {
+  static constexpr std::string_view kNames[] = {"persistence", "likelihood"};
+  return kNames;
+}
+
 // What the vertical channel's answers of the first world_up_alignment_frames frames measure.
 //  kWorldUp: the world's up, which nobody measured (a world that is the first camera): their
 //    estimate becomes the world's up of the vertical channel, its gate and the walk's split.
@@ -115,6 +130,9 @@ struct SunFusionOptions {
   // How the tilt's walk follows the vertical channel (above); evidence_sigmas,
   // evidence_forgetting and evidence_correlation are its test's with kEvidence.
   VerticalDriftAdaptation vertical_drift_adaptation = VerticalDriftAdaptation::kLikelihood;
+  // How the heading's walk follows the sun (above); the bank's walks span [min_drift_deg_per_frame,
+  // max_drift_deg_per_frame] and it shares the likelihood_* settings below.
+  HeadingDriftAdaptation heading_drift_adaptation = HeadingDriftAdaptation::kPersistence;
   // kLikelihood (walk_bank.hpp): walks in the bank, [2, 8], log-spaced over
   // [min_drift_deg_per_frame (> 0), vertical_max_drift_deg_per_frame]; the cue's noise scales
   // (true / reported std), [1, 8], log-spaced over [likelihood_noise_min, likelihood_noise_max],
@@ -196,6 +214,7 @@ struct SunFusionOptions {
     v("max_drift_deg_per_frame", s.max_drift_deg_per_frame);
     v("vertical_max_drift_deg_per_frame", s.vertical_max_drift_deg_per_frame);
     v("vertical_drift_adaptation", s.vertical_drift_adaptation);
+    v("heading_drift_adaptation", s.heading_drift_adaptation);
     v("likelihood_walks", s.likelihood_walks);
     v("likelihood_noise_scales", s.likelihood_noise_scales);
     v("likelihood_noise_min", s.likelihood_noise_min);

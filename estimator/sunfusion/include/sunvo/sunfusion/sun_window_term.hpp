@@ -47,7 +47,10 @@
 //      vertical_max_drift_deg_per_frame, and the sun's answers then add to those sums without
 //      forgetting them (they forget on the cue's answers); or, with vertical_drift_adaptation
 //      kEvidence, q_tilt stays at its floor and the cue's evidence widens P's tilt part; or, with
-//      kLikelihood (the default), q_tilt is what a bank of tilt filters finds most likely. A
+//      kLikelihood (the default), q_tilt is what a bank of tilt filters finds most likely; with
+//      heading_drift_adaptation kLikelihood, once the cue measures, q_heading is what a bank fed
+//      the sun's answers finds most likely (the persistence test cannot fire on a source far
+//      better than it reports once the cue takes the tilt out of its innovations). A
 //      precise "up" that evidences a tilt drift thus no longer widens the heading, which a
 //      12-20 deg sun would then pull around; and a sun beside the "up" neither dilutes the
 //      tilt's test, nor holds its walk to an image estimator's low cap, nor steps it a second
@@ -184,6 +187,10 @@ class SunWindowTerm {
   // and whether it is in use (the likelihood rule with the walk split by gravity).
   const WalkBank& tiltBank() const { return tilt_bank_; }
   bool tiltByLikelihood() const;
+  // heading_drift_adaptation kLikelihood: the bank the heading's walk is chosen from, fed the sun's
+  // answers, and whether it is in use (the likelihood rule with the walk split by gravity).
+  const WalkBank& headingBank() const { return heading_bank_; }
+  bool headingByLikelihood() const;
   double headingDriftDegPerFrame() const {
     return splitByGravity() ? heading_drift_deg_per_frame_ : drift_deg_per_frame_;
   }
@@ -317,6 +324,12 @@ class SunWindowTerm {
   double stepDrift(double q, double step, double cap) const;
   // The tilt's walk follows the vertical channel by the evidence rule (kEvidence, split).
   bool tiltByEvidence() const;
+  // An answer for a walk bank: H = d r / d e (world) and the Huber-weighted r; a 3-D direction's
+  // rows across the measured direction only (its radial row has no first-order signal, and read
+  // as a row of noise it would make the noise scales read sqrt(2/3) of the truth), the bias
+  // Jacobian H_c turned with them. Returns the rows.
+  int bankAnswer(const Innovation& inn, const Eigen::Matrix3d& C_w_b, Eigen::Matrix3d* H,
+                 Eigen::Vector3d* r, Eigen::Matrix<double, 3, 2>* H_c) const;
   // The weight that caps a whitened innovation's norm at persistence_huber sigmas per row.
   double huberWeight(const Innovation& inn) const;
   // Adds an accepted measurement to sums I and g (world frame) after forgetting them by lambda
@@ -381,7 +394,8 @@ class SunWindowTerm {
   double last_nis_ = 0.0;
   std::uint64_t num_inflations_ = 0;
   WorldUpAlignment world_up_;
-  WalkBank tilt_bank_;  // kLikelihood: the tilt's walks and their likelihoods
+  WalkBank tilt_bank_;     // kLikelihood: the tilt's walks and their likelihoods
+  WalkBank heading_bank_;  // heading_drift_adaptation kLikelihood: the heading's
 };
 
 }  // namespace sunvo::sunfusion

@@ -42,7 +42,12 @@
 // (sigma 0 as likely as all the others together). The bank's c is the mixture of its members'
 // (mean weighted by the posterior), which the fusion may take out of the answers before they
 // are fused (two-stage bias estimation: the members see the answers as they came).
-// Fixed-size, no allocation.
+//
+// The same bank chooses the heading's walk from the sun's answers (heading = true,
+// SunFusionOptions::heading_drift_adaptation): the walk is then about up, w_k ~ N(0, q^2 u u^T),
+// and the tilt, which the sun's answers see too, walks by the fusion's own tilt walk in every
+// member (propagate's other_q), so that no member reads the tilt's moves as heading. Fixed-size, no
+// allocation.
 
 #include <Eigen/Core>
 #include <array>
@@ -63,6 +68,9 @@ struct WalkBankOptions {
   int up_bias_scales = 1;          // [1, kMaxBiasScales]; 1 = no bias axis (c is no state)
   double up_bias_max_rad = 0.0;    // rad, > 0 with up_bias_scales > 1: the widest bias std
   double up_bias_length_frames = 2500.0;  // frames, [1, 1e7]: the bias's correlation length
+  // The walk's axis: false = the tilt (the plane normal to up, the cue's bank), true = the
+  // heading (about up, the sun's bank; SunFusionOptions::heading_drift_adaptation).
+  bool heading = false;
 };
 
 class WalkBank {
@@ -73,8 +81,10 @@ class WalkBank {
   using BiasJacobian = Eigen::Matrix<double, 3, 2>;
 
   Status init(const WalkBankOptions& options);
-  // frames have passed: each P grows by q_j^2 frames on the plane normal to up.
-  void propagate(double frames, const Eigen::Vector3d& up);
+  // frames have passed: each P grows by q_j^2 frames on its walk's subspace (the plane normal to
+  // up, or up itself for a heading bank) and by other_q^2 frames (rad per frame: the fusion's walk
+  // there) on the other one, so that a member is not sure of what it does not choose.
+  void propagate(double frames, const Eigen::Vector3d& up, double other_q = 0.0);
   // One answer: m (1..3) whitened rows r (at the current estimate, c = 0), H = d r / d e (world)
   // and H_c its dependence on the cue's bias c (ignored without a bias axis).
   void update(const Eigen::Matrix3d& H, const BiasJacobian& H_c, const Eigen::Vector3d& r, int m);
@@ -115,6 +125,7 @@ class WalkBank {
   int biases_ = 1;
   double forgetting_ = 1.0;
   double bias_length_ = 2500.0;
+  bool heading_ = false;
   std::array<double, kMaxWalks> log_q_{};
   std::array<double, kMaxScales> log_s_{};
   std::array<double, kMaxBiasScales> bias_sigma_{};  // rad
