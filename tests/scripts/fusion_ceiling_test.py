@@ -32,14 +32,15 @@ def write_poses(path, poses):
 
 
 def straight_drive(directory, error, frames=60):
-    """The truth drives 1 m per frame along z, level; VO's attitude is off by `error` from frame 1
-    on and it chains the true steps with it (what an attitude error does to a VO run)."""
+    """The truth drives 1 m per frame along z, level; VO's attitude is off by `error` (a rotation,
+    or a function of the frame giving one) from frame 1 on and it chains the true steps with it
+    (what an attitude error does to a VO run)."""
     identity = rot("x", 0.0)
     gt = [(identity, [0.0, 0.0, float(k)]) for k in range(frames)]
     run = [(identity, [0.0, 0.0, 0.0])]
     for k in range(1, frames):
         p = [a + b for a, b in zip(run[-1][1], mat_vec(run[-1][0], [0.0, 0.0, 1.0]))]
-        run.append((error, p))
+        run.append((error(k) if callable(error) else error, p))
     write_poses(os.path.join(directory, "gt.txt"), gt)
     write_poses(os.path.join(directory, "vo.txt"), run)
     return os.path.join(directory, "gt.txt"), os.path.join(directory, "vo.txt")
@@ -83,16 +84,8 @@ class FusionCeiling(unittest.TestCase):
     def test_a_steady_drift_is_followed_between_answers_by_the_rate_state(self):
         with tempfile.TemporaryDirectory() as d:
             # VO pitches 0.02 deg per frame: 6 deg after 300 frames
-            frames = 300
-            identity = rot("x", 0.0)
-            gt = [(identity, [0.0, 0.0, float(k)]) for k in range(frames)]
-            run = [(identity, [0.0, 0.0, 0.0])]
-            for k in range(1, frames):
-                p = [a + b for a, b in zip(run[-1][1], mat_vec(run[-1][0], [0.0, 0.0, 1.0]))]
-                run.append((rot("x", math.radians(0.02 * k)), p))
-            write_poses(os.path.join(d, "gt.txt"), gt)
-            write_poses(os.path.join(d, "vo.txt"), run)
-            common = [os.path.join(d, "gt.txt"), os.path.join(d, "vo.txt"), "--seeds", "2",
+            gt, vo = straight_drive(d, lambda k: rot("x", math.radians(0.02 * k)), frames=300)
+            common = [gt, vo, "--seeds", "2",
                       "--q-tilt", "0.002", "--q-heading", "0.002", "--sources", "up",
                       "--vertical-sigma-deg", "1"]
             walk = self.run_script(*common)

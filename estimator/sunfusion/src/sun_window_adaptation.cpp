@@ -89,7 +89,23 @@ void SunWindowTerm::adaptDrift(const Innovation& inn, const Eigen::Matrix3d& C_w
         } else if (!vertical_in_sums_) {
           drift_deg_per_frame_ = clampDrift(drift_deg_per_frame_ * std::exp(step));
         }
-        if (channel == 0) {
+        if (channel == 0 && headingByLikelihood()) {
+          // The heading's walk the sun's innovations make most likely, as the tilt's above. The
+          // bank is fed from the first answer but chooses the walk only once the cue takes the
+          // tilt: before that the tilt's error in the sun's innovations fires the persistence
+          // test, which then holds both walks up (docs/vertical.md, "the heading's walk"), and
+          // the bank, whose members take the tilt's walk as given, would read it as heading.
+          Eigen::Matrix3d H;
+          Eigen::Vector3d r;
+          Eigen::Matrix<double, 3, 2> H_c;
+          const int rows = bankAnswer(inn, C_w_b, &H, &r, &H_c);
+          heading_bank_.update(H, r, rows);
+        }
+        if (channel == 0 && headingByLikelihood() && vertical_in_sums_) {
+          heading_drift_deg_per_frame_ =
+              std::clamp(heading_bank_.walk() / kDeg, options_.min_drift_deg_per_frame,
+                         options_.max_drift_deg_per_frame);
+        } else if (channel == 0) {
           accumulate(inn, C_w_b, &sun_I_, &sun_g_, options_.persistence_forgetting);
           std::size_t sun_rank = 0;
           const double T = sunfusion::persistenceStatistic(sun_I_, sun_g_, &sun_rank);
@@ -98,23 +114,6 @@ void SunWindowTerm::adaptDrift(const Innovation& inn, const Eigen::Matrix3d& C_w
                                     : -options_.persistence_step_down;
           heading_drift_deg_per_frame_ =
               clampDrift(heading_drift_deg_per_frame_ * std::exp(step_h));
-          if (headingByLikelihood()) {
-            // The heading's walk the sun's innovations make most likely, as the tilt's above. The
-            // bank is fed from the first answer but chooses the walk only once the cue takes the
-            // tilt: before that the tilt's error in the sun's innovations fires the persistence
-            // test, which then holds both walks up (docs/vertical.md, "the heading's walk"), and
-            // the bank, whose members take the tilt's walk as given, would read it as heading.
-            Eigen::Matrix3d H;
-            Eigen::Vector3d r;
-            Eigen::Matrix<double, 3, 2> H_c;
-            const int rows = bankAnswer(inn, C_w_b, &H, &r, &H_c);
-            heading_bank_.update(H, r, rows);
-            if (vertical_in_sums_) {
-              heading_drift_deg_per_frame_ =
-                  std::clamp(heading_bank_.walk() / kDeg, options_.min_drift_deg_per_frame,
-                             options_.max_drift_deg_per_frame);
-            }
-          }
         }
         return;
       }
