@@ -260,6 +260,17 @@ TEST(Drive, AResumedRenderKeepsTheFramesDoneAndRendersTheRest) {
   ASSERT_TRUE(renderDrive(*s, out.string(), 2, {}));
   EXPECT_TRUE(std::filesystem::exists(image(0, 1)));
   EXPECT_FALSE(std::filesystem::exists(image(0, 2)));
+
+  // Resuming where nothing was rendered renders the whole drive.
+  std::filesystem::remove_all(out);
+  s->frames = 1;
+  DriveProgress fresh;
+  auto whole = renderDrive(
+      *s, out.string(), 2, [&](const DriveProgress& p) { fresh = p; }, true);
+  ASSERT_TRUE(whole) << whole.status().toString();
+  EXPECT_EQ(fresh.kept_frames, 0u);
+  EXPECT_EQ(fresh.done, 2u);
+  EXPECT_EQ(readText(image(0, 0)), first[0]);
 }
 
 }  // namespace

@@ -244,6 +244,10 @@ Expected<std::string> renderDrive(const Scenario& s, const std::string& out_root
   std::error_code ec;
   const std::string manifest_path = drive_dir + "/render_manifest.txt";
   const std::string manifest = renderManifest(s);
+  // Nothing to continue: a resumed render into a folder without this drive is a fresh one (a
+  // script may always pass --resume).
+  if (resume && !fs::exists(drive_dir, ec)) resume = false;
+  ec.clear();
   if (resume) {
     const std::optional<std::string> old = readText(manifest_path);
     if (!old) {

@@ -30,7 +30,7 @@ int main(int argc, char** argv) {
   app.add_flag("--resume", resume,
                "continue a render that stopped part-way into the same --out: frames whose images "
                "exist and whose scene is unchanged are kept (the folder's render_manifest.txt must "
-               "match the scenario)");
+               "match the scenario; a drive not rendered yet is rendered whole)");
   if (auto code = sunvo::cli::parse(app, argc, argv)) return *code;
   auto s = sunvo::render::loadScenario(scenario);
   if (!s) return sunvo::cli::fail(kProgram, s.status());

@@ -131,7 +131,8 @@ struct DriveProgress {
 // of a session): the folder's render_manifest.txt (the render format, the scenario's text, the
 // camera and the render quality) must be this run's, and a frame is kept when its four images
 // exist and its POV-Ray scene (frame_NNNNNN.pov) is the one this run writes, byte for byte; the
-// rest is rendered. The ground truth, OXTS and calibration are written again either way.
+// rest is rendered; a folder without this drive is rendered whole, as a fresh render. The ground
+// truth, OXTS and calibration are written again either way.
 Expected<std::string> renderDrive(const Scenario& s, const std::string& out_root, int jobs,
                                   const std::function<void(const DriveProgress&)>& progress,
                                   bool resume = false);
