@@ -445,7 +445,11 @@ void SunWindowTerm::propagate(double frames) {
   }
   if (tiltByLikelihood()) tilt_bank_.propagate(frames, worldUp());
   if (headingByLikelihood()) {
-    heading_bank_.propagate(frames, worldUp(), drift_deg_per_frame_ * kDeg);
+    // The heading bank's members walk in tilt as the truth does once they take the cue's answers
+    // in at its noise scale: the tilt bank's own walk, not the fusion's gain-matched one.
+    const bool cue_in = vertical_in_sums_ && tiltByLikelihood();
+    heading_bank_.propagate(frames, worldUp(),
+                            cue_in ? tilt_bank_.tiltWalk() : drift_deg_per_frame_ * kDeg);
   }
   const double q = drift_deg_per_frame_ * kDeg;
   if (!splitByGravity() || heading_drift_deg_per_frame_ == drift_deg_per_frame_) {

@@ -143,6 +143,28 @@ void WalkBank::update(const Eigen::Matrix3d& H, const BiasJacobian& H_c, const E
   }
 }
 
+void WalkBank::absorb(const Eigen::Matrix3d& H, const Eigen::Vector3d& r, int m, double s) {
+  if (walks_ == 0 || m < 1 || m > 3 || !(s > 0.0) || !std::isfinite(s) || !H.allFinite() ||
+      !r.allFinite()) {
+    return;
+  }
+  Eigen::Matrix<double, 3, 5> H5 = Eigen::Matrix<double, 3, 5>::Zero();
+  H5.leftCols<3>() = H;
+  H5.bottomRows(3 - m).setZero();
+  Eigen::Vector3d rm = r;
+  rm.tail(3 - m).setZero();
+  for (int k = 0; k < members(); ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    double unused = 0.0;
+    if (biases_ == 1) {
+      updateMember<3>(Eigen::Matrix3d(H5.leftCols<3>()), rm, m, s, x_[i].head<3>(),
+                      P_[i].topLeftCorner<3, 3>(), &unused);
+    } else {
+      updateMember<5>(H5, rm, m, s, x_[i].head<5>(), P_[i].topLeftCorner<5, 5>(), &unused);
+    }
+  }
+}
+
 void WalkBank::shift(const Eigen::Vector3d& c_w) {
   if (!c_w.allFinite()) return;
   for (int k = 0; k < members(); ++k) x_[static_cast<std::size_t>(k)].head<3>() -= c_w;

@@ -46,8 +46,9 @@
 // The same bank chooses the heading's walk from the sun's answers (heading = true,
 // SunFusionOptions::heading_drift_adaptation): the walk is then about up, w_k ~ N(0, q^2 u u^T),
 // and the tilt, which the sun's answers see too, walks by the fusion's own tilt walk in every
-// member (propagate's other_q), so that no member reads the tilt's moves as heading. Fixed-size, no
-// allocation.
+// member (propagate's other_q), so that no member reads the tilt's moves as heading; once the cue
+// measures, the members take its answers in too (absorb), so that the tilt left in the sun's rows
+// they judge is the tilt the fusion has left. Fixed-size, no allocation.
 
 #include <Eigen/Core>
 #include <array>
@@ -91,6 +92,11 @@ class WalkBank {
   void update(const Eigen::Matrix3d& H, const Eigen::Vector3d& r, int m) {
     update(H, BiasJacobian::Zero(), r, m);
   }
+  // An answer of the other channel (the cue's, for a heading bank): every member's e takes in its
+  // m whitened rows with noise std s, as the fusion does; the likelihoods are left as they are,
+  // so the walk is chosen by this bank's own channel's answers while its members know the tilt the
+  // fusion knows. A bias axis is not informed (the rows are taken at c = 0).
+  void absorb(const Eigen::Matrix3d& H, const Eigen::Vector3d& r, int m, double s);
   // The estimate was corrected by the world rotation vector c_w.
   void shift(const Eigen::Vector3d& c_w);
   // The walk for a fusion that weighs the answers by their reported sigma, exp(E[log q - log s]),
