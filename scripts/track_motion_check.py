@@ -11,10 +11,13 @@ sign flips across the principal row.
 
 With --vo POSES (a KITTI pose file of the same frames, e.g. sunvo_track_vo's output) it also
 prints the median pitch of the per-frame translation direction in the camera, atan2(t_y, t_z) of
-T_k-1,k, for the ground truth and the estimate: a principal-point error of d px or a tilted
-translation would put d / fv between the two.
+T_k-1,k, for the ground truth and the estimate (a principal-point error of d px or a tilted
+translation would put d / fv between the two), and the mean per-frame differences, estimate minus
+truth, of T_k,k-1's vertical translation t_y and of its rotation about the camera's x axis: what
+the two motions' row predictions differ by (fv t_y / z and fv times the angle). With --under POSES
+the residual is taken under that file's motion instead of the truth's.
 
-Pure Python (no numpy): python3 scripts/track_motion_check.py FOLDER [--vo POSES]
+Pure Python (no numpy): python3 scripts/track_motion_check.py FOLDER [--vo POSES] [--under POSES]
 """
 import argparse
 import math
@@ -95,6 +98,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("folder", help="track folder: calib.txt, gt_poses.txt, tracks.csv")
     ap.add_argument("--vo", help="a KITTI pose file of the same frames")
+    ap.add_argument("--under", help="take the residual under this pose file's motion")
     args = ap.parse_args()
     calib_path = f"{args.folder}/calib.txt"
     try:
@@ -104,12 +108,17 @@ def main():
         fail(f"{calib_path}: {e.strerror}")
     gt = read_poses(f"{args.folder}/gt_poses.txt")
     tracks = read_tracks(f"{args.folder}/tracks.csv")
+    motion = gt
+    if args.under:
+        motion = read_poses(args.under)
+        if len(motion) != len(gt):
+            fail(f"{args.under}: {len(motion)} poses, the ground truth has {len(gt)}")
 
     # (bin, side) -> residuals; side 0 all, 1 above, 2 below the principal row.
     res = {(b, s): [] for b in range(len(BINS) - 1) for s in range(3)}
-    for k in range(1, len(gt)):
+    for k in range(1, len(motion)):
         prev, cur = tracks.get(k - 1, {}), tracks.get(k, {})
-        T_k_km1 = relative(gt[k], gt[k - 1])
+        T_k_km1 = relative(motion[k], motion[k - 1])
         for lm, (u, v, ur, _vr) in prev.items():
             if lm not in cur or u - ur < 1.0:
                 continue
@@ -125,7 +134,8 @@ def main():
                         res[(b, 1)].append(r)
                     elif v - cv > SIDE_PX:
                         res[(b, 2)].append(r)
-    print("row residual under the true motion [px], median by depth in k-1:")
+    which = f"the motion of {args.under}" if args.under else "the true motion"
+    print(f"row residual under {which} [px], median by depth in k-1:")
     for b in range(len(BINS) - 1):
         lo, hi = BINS[b], BINS[b + 1]
         span = f"{lo:.0f}-{hi:.0f} m" if hi < math.inf else f"> {lo:.0f} m"
@@ -137,7 +147,15 @@ def main():
         if len(vo) != len(gt):
             fail(f"{args.vo}: {len(vo)} poses, the ground truth has {len(gt)}")
         pitch_gt, pitch_vo, diff = [], [], []
+        d_ty, d_rx = [], []
         for k in range(1, len(gt)):
+            r_gt, t_gt_k = relative(gt[k], gt[k - 1])
+            r_vo, t_vo_k = relative(vo[k], vo[k - 1])
+            d_ty.append(t_vo_k[1] - t_gt_k[1])
+            # R_vo R_gt^T, its small angle about x: (m[2][1] - m[1][2]) / 2.
+            m = [[sum(r_vo[i][n] * r_gt[j][n] for n in range(3)) for j in range(3)]
+                 for i in range(3)]
+            d_rx.append(0.5 * (m[2][1] - m[1][2]))
             t_gt = relative(gt[k - 1], gt[k])[1]
             t_vo = relative(vo[k - 1], vo[k])[1]
             if math.hypot(*t_gt) < 0.3 or math.hypot(*t_vo) < 0.3:
@@ -152,6 +170,10 @@ def main():
               f"truth {1e3 * statistics.median(pitch_gt):+.2f} mrad, "
               f"estimate {1e3 * statistics.median(pitch_vo):+.2f} mrad, "
               f"estimate - truth {1e3 * statistics.median(diff):+.2f} mrad")
+        print(f"T_k,k-1 estimate - truth, mean (median) over {len(d_ty)} frames: vertical "
+              f"translation t_y {1e3 * statistics.fmean(d_ty):+.2f} "
+              f"({1e3 * statistics.median(d_ty):+.2f}) mm, rotation about x "
+              f"{1e3 * statistics.fmean(d_rx):+.3f} ({1e3 * statistics.median(d_rx):+.3f}) mrad")
 
 
 if __name__ == "__main__":

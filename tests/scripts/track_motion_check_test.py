@@ -81,6 +81,19 @@ class TrackMotionCheck(unittest.TestCase):
             self.assertLess(near[0], 3.0 * far[0])
             self.assertIn("estimate - truth -4.00 mrad", out.stdout)
 
+    def test_under_the_motion_that_explains_the_rows_none_is_left(self):
+        with tempfile.TemporaryDirectory() as d:
+            # The 3 px row error read as a translation tilted by 3 / FU rad: the estimate's
+            # vertical step differs from the truth's by -3 / FU m per metre.
+            write_folder(d, CV - 3.0, vo_tilt=-3.0 / FU)
+            vo = os.path.join(d, "vo.txt")
+            out = self.run_script(d, "--vo", vo, "--under", vo)
+            self.assertEqual(out.returncode, 0, out.stderr)
+            self.assertIn(f"under the motion of {vo}", out.stdout)
+            for value in medians(out.stdout, "5-10 m") + medians(out.stdout, "15-20 m"):
+                self.assertAlmostEqual(value, 0.0, delta=0.02)
+            self.assertIn("vertical translation t_y -4.29 (-4.29) mm", out.stdout)
+
     def test_a_malformed_line_names_file_and_line(self):
         with tempfile.TemporaryDirectory() as d:
             write_folder(d, CV)
