@@ -12,13 +12,19 @@ import math
 
 def load(path):
     poses = []
-    with open(path) as f:
-        for number, line in enumerate(f, 1):
-            v = line.split()
-            if len(v) != 12:
-                raise SystemExit(f"{path}:{number}: expected 12 numbers, got {len(v)}")
-            v = [float(x) for x in v]
-            poses.append(([v[0:3], v[4:7], v[8:11]], [v[3], v[7], v[11]]))
+    try:
+        with open(path) as f:
+            for number, line in enumerate(f, 1):
+                v = line.split()
+                if len(v) != 12:
+                    raise SystemExit(f"{path}:{number}: expected 12 numbers, got {len(v)}")
+                try:
+                    v = [float(x) for x in v]
+                except ValueError:
+                    raise SystemExit(f"{path}:{number}: not a number in '{line.strip()}'")
+                poses.append(([v[0:3], v[4:7], v[8:11]], [v[3], v[7], v[11]]))
+    except OSError as e:
+        raise SystemExit(f"{path}: {e.strerror}")
     return poses
 
 

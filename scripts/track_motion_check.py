@@ -24,6 +24,9 @@ import math
 import statistics
 import sys
 
+# The pose files' reader and the rotation helpers are pose_error_split.py's (this folder).
+from pose_error_split import load, mul, transpose
+
 BINS = (5.0, 10.0, 15.0, 20.0, 30.0, 60.0, math.inf)
 SIDE_PX = 20.0
 
@@ -43,28 +46,11 @@ def numbers(path, line_no, text, count):
     return values
 
 
-def read_poses(path):
-    poses = []
-    try:
-        with open(path) as f:
-            for i, line in enumerate(f, 1):
-                if not line.strip():
-                    continue
-                v = numbers(path, i, line, 12)
-                poses.append(([v[0:3], v[4:7], v[8:11]], [v[3], v[7], v[11]]))
-    except OSError as e:
-        fail(f"{path}: {e.strerror}")
-    return poses
-
-
 def relative(pose_a, pose_b):
     """T_a^-1 T_b: pose b in frame a."""
-    ra, ta = pose_a
-    rb, tb = pose_b
-    r = [[sum(ra[k][i] * rb[k][j] for k in range(3)) for j in range(3)] for i in range(3)]
-    d = [tb[k] - ta[k] for k in range(3)]
-    t = [sum(ra[k][i] * d[k] for k in range(3)) for i in range(3)]
-    return r, t
+    ra_t = transpose(pose_a[0])
+    d = [b - a for a, b in zip(pose_a[1], pose_b[1])]
+    return mul(ra_t, pose_b[0]), [sum(ra_t[i][k] * d[k] for k in range(3)) for i in range(3)]
 
 
 def apply(pose, p):
@@ -106,11 +92,11 @@ def main():
             fu, fv, cu, cv, base = numbers(calib_path, 1, f.readline(), 5)
     except OSError as e:
         fail(f"{calib_path}: {e.strerror}")
-    gt = read_poses(f"{args.folder}/gt_poses.txt")
+    gt = load(f"{args.folder}/gt_poses.txt")
     tracks = read_tracks(f"{args.folder}/tracks.csv")
     motion = gt
     if args.under:
-        motion = read_poses(args.under)
+        motion = load(args.under)
         if len(motion) != len(gt):
             fail(f"{args.under}: {len(motion)} poses, the ground truth has {len(gt)}")
 
@@ -143,7 +129,7 @@ def main():
         print(f"  {span:9s} all {cells[0]}, above the principal row {cells[1]}, below {cells[2]}")
 
     if args.vo:
-        vo = read_poses(args.vo)
+        vo = load(args.vo)
         if len(vo) != len(gt):
             fail(f"{args.vo}: {len(vo)} poses, the ground truth has {len(gt)}")
         pitch_gt, pitch_vo, diff = [], [], []
@@ -153,8 +139,7 @@ def main():
             r_vo, t_vo_k = relative(vo[k], vo[k - 1])
             d_ty.append(t_vo_k[1] - t_gt_k[1])
             # R_vo R_gt^T, its small angle about x: (m[2][1] - m[1][2]) / 2.
-            m = [[sum(r_vo[i][n] * r_gt[j][n] for n in range(3)) for j in range(3)]
-                 for i in range(3)]
+            m = mul(r_vo, transpose(r_gt))
             d_rx.append(0.5 * (m[2][1] - m[1][2]))
             t_gt = relative(gt[k - 1], gt[k])[1]
             t_vo = relative(vo[k - 1], vo[k])[1]

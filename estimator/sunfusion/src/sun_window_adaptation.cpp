@@ -89,29 +89,25 @@ void SunWindowTerm::adaptDrift(const Innovation& inn, const Eigen::Matrix3d& C_w
         } else if (!vertical_in_sums_) {
           drift_deg_per_frame_ = clampDrift(drift_deg_per_frame_ * std::exp(step));
         }
-        if (channel == 1 && headingByLikelihood()) {
-          // The heading bank's members take the cue's answer in as the fusion did (a bias it took
-          // out stays out), with the noise scale the tilt's bank reads (the reported sigma under
-          // the other tilt rules).
+        if (headingByLikelihood()) {
+          // Both channels feed the heading's bank, each answer as the fusion took it (a bias taken
+          // out of the cue's stays out; the sun's has none). The sun's answers choose its walk,
+          // as the tilt's above; it is fed from the first one but chooses only once the cue takes
+          // the tilt: before that the tilt's error in the sun's innovations fires the persistence
+          // test, which then holds both walks up (docs/vertical.md, "the heading's walk"), and
+          // the bank would read it as heading. The cue's answers tell its members the tilt, at
+          // the noise scale the tilt's bank reads (the reported sigma under the other tilt rules).
           Innovation fused = inn;
           fused.up_bias_removed.setZero();
           Eigen::Matrix3d H;
           Eigen::Vector3d r;
           Eigen::Matrix<double, 3, 2> H_c;
           const int rows = bankAnswer(fused, C_w_b, &H, &r, &H_c);
-          heading_bank_.absorb(H, r, rows, tiltByLikelihood() ? tilt_bank_.noiseScale() : 1.0);
-        }
-        if (channel == 0 && headingByLikelihood()) {
-          // The heading's walk the sun's innovations make most likely, as the tilt's above. The
-          // bank is fed from the first answer but chooses the walk only once the cue takes the
-          // tilt: before that the tilt's error in the sun's innovations fires the persistence
-          // test, which then holds both walks up (docs/vertical.md, "the heading's walk"), and
-          // the bank, whose members take the tilt's walk as given, would read it as heading.
-          Eigen::Matrix3d H;
-          Eigen::Vector3d r;
-          Eigen::Matrix<double, 3, 2> H_c;
-          const int rows = bankAnswer(inn, C_w_b, &H, &r, &H_c);
-          heading_bank_.update(H, r, rows);
+          if (channel == 0) {
+            heading_bank_.update(H, r, rows);
+          } else {
+            heading_bank_.absorb(H, r, rows, tiltByLikelihood() ? tilt_bank_.noiseScale() : 1.0);
+          }
         }
         if (channel == 0 && headingByLikelihood() && vertical_in_sums_) {
           heading_drift_deg_per_frame_ =

@@ -119,6 +119,16 @@ bool updateMember(const Eigen::Matrix<double, 3, N>& H, const Eigen::Vector3d& r
 
 void WalkBank::update(const Eigen::Matrix3d& H, const BiasJacobian& H_c, const Eigen::Vector3d& r,
                       int m) {
+  updateMembers(H, H_c, r, m, std::nullopt);
+}
+
+void WalkBank::absorb(const Eigen::Matrix3d& H, const Eigen::Vector3d& r, int m, double s) {
+  if (!(s > 0.0) || !std::isfinite(s)) return;
+  updateMembers(H, BiasJacobian::Zero(), r, m, s);
+}
+
+void WalkBank::updateMembers(const Eigen::Matrix3d& H, const BiasJacobian& H_c,
+                             const Eigen::Vector3d& r, int m, std::optional<double> other_s) {
   if (walks_ == 0 || m < 1 || m > 3 || !H.allFinite() || !H_c.allFinite() || !r.allFinite()) {
     return;
   }
@@ -132,36 +142,15 @@ void WalkBank::update(const Eigen::Matrix3d& H, const BiasJacobian& H_c, const E
   H5.bottomRows(3 - m).setZero();
   for (int k = 0; k < members(); ++k) {
     const auto i = static_cast<std::size_t>(k);
-    const double s = std::exp(log_s_[scaleOf(k)]);
+    const double s = other_s ? *other_s : std::exp(log_s_[scaleOf(k)]);
     double l = 0.0;
     // Without a bias axis the members are filters of e alone (the same arithmetic as before it).
     const bool ok =
         biases_ == 1
             ? updateMember<3>(Hm, rm, m, s, x_[i].head<3>(), P_[i].topLeftCorner<3, 3>(), &l)
             : updateMember<5>(H5, rm, m, s, x_[i].head<5>(), P_[i].topLeftCorner<5, 5>(), &l);
-    if (ok) loglik_[i] = forgetting_ * loglik_[i] + l;
-  }
-}
-
-void WalkBank::absorb(const Eigen::Matrix3d& H, const Eigen::Vector3d& r, int m, double s) {
-  if (walks_ == 0 || m < 1 || m > 3 || !(s > 0.0) || !std::isfinite(s) || !H.allFinite() ||
-      !r.allFinite()) {
-    return;
-  }
-  Eigen::Matrix<double, 3, 5> H5 = Eigen::Matrix<double, 3, 5>::Zero();
-  H5.leftCols<3>() = H;
-  H5.bottomRows(3 - m).setZero();
-  Eigen::Vector3d rm = r;
-  rm.tail(3 - m).setZero();
-  for (int k = 0; k < members(); ++k) {
-    const auto i = static_cast<std::size_t>(k);
-    double unused = 0.0;
-    if (biases_ == 1) {
-      updateMember<3>(Eigen::Matrix3d(H5.leftCols<3>()), rm, m, s, x_[i].head<3>(),
-                      P_[i].topLeftCorner<3, 3>(), &unused);
-    } else {
-      updateMember<5>(H5, rm, m, s, x_[i].head<5>(), P_[i].topLeftCorner<5, 5>(), &unused);
-    }
+    // The other channel's answers inform the states only: the walk is chosen by this bank's own.
+    if (ok && !other_s) loglik_[i] = forgetting_ * loglik_[i] + l;
   }
 }
 

@@ -52,6 +52,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <optional>
 
 #include "sunvo/core/status.hpp"
 
@@ -120,6 +121,11 @@ class WalkBank {
   std::size_t walkOf(int k) const { return static_cast<std::size_t>(k / (scales_ * biases_)); }
   std::size_t scaleOf(int k) const { return static_cast<std::size_t>((k / biases_) % scales_); }
   std::size_t biasOf(int k) const { return static_cast<std::size_t>(k % biases_); }
+  // Every member's Kalman update by one answer: with its own noise scale and its likelihood
+  // counted (update), or with the other channel's noise std other_s and the likelihood left
+  // (absorb).
+  void updateMembers(const Eigen::Matrix3d& H, const BiasJacobian& H_c, const Eigen::Vector3d& r,
+                     int m, std::optional<double> other_s);
   double mean(bool walk_part, bool noise_part) const;
   double logPosterior(int member) const;
   double maxLogPosterior() const;  // over the members, for weights without overflow
