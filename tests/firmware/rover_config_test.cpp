@@ -39,7 +39,7 @@ TEST(RoverConfig, TheShippedConfigsLoad) {
   ASSERT_TRUE(rover) << rover.status().toString();
   EXPECT_EQ(rover->source.type, SourceType::kV4l2);
   EXPECT_EQ(rover->trigger.type, TriggerType::kGpio);
-  EXPECT_EQ(rover->sun.model, "/usr/share/sunvo/sun_cnn_gray.onnx");  // installed by the .deb
+  EXPECT_EQ(rover->sun.model, "/usr/share/sunvo/sun_cnn.onnx");  // installed by the .deb
   // The image estimator's azimuth error is a state of the fusion (docs/fusion_bias.md); the
   // replay file's true sun has none.
   EXPECT_EQ(rover->estimator.fusion.sun_bias_sigma_deg, 30.0);

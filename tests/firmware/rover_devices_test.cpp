@@ -52,11 +52,10 @@ RunResult runRig(int exposures, int drop_at, const std::string& sun_provider = "
 
   const std::string out = std::string(SUNVO_BINARY_DIR) + "/test_out/rover_devices";
   auto overrides = testing::rigOverrides(out);
-  overrides.insert(
-      overrides.end(),
-      {{"sun.provider", sun_provider},
-       {"sun.model", sun_model.empty() ? "/usr/share/sunvo/sun_cnn_gray.onnx" : sun_model},
-       {"telemetry.pose_log", pose_log.empty() ? "\"\"" : pose_log}});
+  overrides.insert(overrides.end(),
+                   {{"sun.provider", sun_provider},
+                    {"sun.model", sun_model.empty() ? "/usr/share/sunvo/sun_cnn.onnx" : sun_model},
+                    {"telemetry.pose_log", pose_log.empty() ? "\"\"" : pose_log}});
   auto config = loadRoverConfig(std::string(SUNVO_SOURCE_DIR) + "/config/rover.yaml", overrides);
   EXPECT_TRUE(config.hasValue()) << config.status().toString();
   if (!config) return result;
@@ -155,10 +154,11 @@ TEST(RoverDevices, LalondeRunsOnTheGrayFramesOfTheV4l2Cameras) {
 }
 
 TEST(RoverDevices, SunCnnRunsOnTheGreyFramesOfTheV4l2Cameras) {
-  // The grey model (as config/rover.yaml names it, here from the source tree) on the luma-only
-  // V4L2 frames: every fifth frame goes to the sun thread and comes back without an error.
+  // The colour model fed (Y, Y, Y) with its grey-input calibration (as config/rover.yaml names
+  // it, here from the source tree) on the luma-only V4L2 frames: every fifth frame goes to the
+  // sun thread and comes back without an error.
   const RunResult r =
-      runRig(20, -1, "sun_cnn", "", std::string(SUNVO_SOURCE_DIR) + "/config/sun_cnn_gray.onnx");
+      runRig(20, -1, "sun_cnn", "", std::string(SUNVO_SOURCE_DIR) + "/config/sun_cnn.onnx");
   expectPosesAtStrobes(r);
   expectSunCalls(r, "sun_cnn", 3);
 }

@@ -189,7 +189,69 @@ TEST(SunCnnEstimator, DefaultsMatchTheShippedModelsJson) {
   EXPECT_EQ(o.mask1_size, j.mask1_size);
   EXPECT_EQ(o.mask2_size, j.mask2_size);
   EXPECT_DOUBLE_EQ(o.dropout_p, j.dropout_p);
+  EXPECT_NEAR(o.gray_sigma_scale, j.gray_sigma_scale, 5e-5) << "gray_input.sigma_scale";
+  EXPECT_NEAR(o.gray_max_valid_sigma_rad, j.gray_max_valid_sigma_rad, 5e-5)
+      << "gray_input.max_valid_sigma_rad";
+  EXPECT_NE(j.gray_sigma_scale, j.sigma_scale);  // the colour model has a grey calibration
   EXPECT_EQ(optionsOf(kGrayModel).input_channels, 1);
+}
+
+// A grey image on a colour model takes the grey-input numbers, a colour image the colour ones;
+// a grey model (input_channels 1) never uses them.
+TEST(SunCnnEstimator, AGreyImageOnTheColourModelTakesTheGreyCalibration) {
+  const HeldOutFrames& f = heldOutFrames();
+  ASSERT_FALSE(f.images.empty());
+  const cv::Mat colour = f.images[0], grey_image = grey(f.images[0]);
+  const auto sigmaAndValid = [](const SunCnnOptions& o, const std::string& model,
+                                const cv::Mat& img) {
+    SunCnnEstimator est;
+    EXPECT_TRUE(est.init(o, model).isOk());
+    auto e = est.estimate(inputOf(img));
+    EXPECT_TRUE(e.hasValue());
+    EXPECT_EQ(est.lastRaw().gray_calibration, img.type() == CV_8UC1 && o.input_channels == 3);
+    return e ? std::pair{e->measurement.sigma, e->valid} : std::pair{0.0, false};
+  };
+  SunCnnOptions o = optionsOf(kModel);
+  o.sigma_min_rad = 0.0;  // no floor, so that sigma scales exactly
+  SunCnnOptions twice = o;
+  twice.gray_sigma_scale = 2.0 * o.gray_sigma_scale;
+  twice.gray_max_valid_sigma_rad = 1e-6;  // every grey answer invalid
+  const auto [s_grey, v_grey] = sigmaAndValid(o, kModel, grey_image);
+  const auto [s_grey2, v_grey2] = sigmaAndValid(twice, kModel, grey_image);
+  EXPECT_NEAR(s_grey2, 2.0 * s_grey, 1e-9 * s_grey);
+  EXPECT_FALSE(v_grey2);
+  // The colour image does not see the grey numbers.
+  EXPECT_EQ(sigmaAndValid(o, kModel, colour), sigmaAndValid(twice, kModel, colour));
+  // Sigma on the grey image against the colour numbers: the ratio of the two scales.
+  SunCnnOptions colour_numbers = o;
+  colour_numbers.gray_sigma_scale = o.sigma_scale;
+  EXPECT_NEAR(sigmaAndValid(colour_numbers, kModel, grey_image).first / s_grey,
+              o.sigma_scale / o.gray_sigma_scale, 1e-9);
+  // A grey model ignores them.
+  SunCnnOptions g = optionsOf(kGrayModel), g2 = g;
+  g2.gray_sigma_scale = 50.0;
+  g2.gray_max_valid_sigma_rad = 1e-6;
+  EXPECT_EQ(sigmaAndValid(g, kGrayModel, grey_image), sigmaAndValid(g2, kGrayModel, grey_image));
+  (void)v_grey;
+}
+
+// A model JSON without "gray_input" (calibrated before grey inputs had their own numbers) gives
+// grey images the colour numbers; with it, its own.
+TEST(SunCnnEstimator, AJsonWithoutAGreyCalibrationGivesGreyImagesTheColourOne) {
+  const std::string dir = std::string(SUNVO_BINARY_DIR) + "/suncnn_test";
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir + "/old.json") << "{ \"sigma_scale\": 0.6, \"max_valid_sigma_rad\": 0.45 }\n";
+  auto old = loadSunCnnOptions(dir + "/old.json");
+  ASSERT_TRUE(old.hasValue()) << old.status().toString();
+  EXPECT_DOUBLE_EQ(old->gray_sigma_scale, 0.6);
+  EXPECT_DOUBLE_EQ(old->gray_max_valid_sigma_rad, 0.45);
+  std::ofstream(dir + "/new.json") << "{ \"sigma_scale\": 0.6, \"gray_input\": { "
+                                      "\"sigma_scale\": 0.8, \"max_valid_sigma_rad\": 0.55 } }\n";
+  auto with = loadSunCnnOptions(dir + "/new.json");
+  ASSERT_TRUE(with.hasValue()) << with.status().toString();
+  EXPECT_DOUBLE_EQ(with->sigma_scale, 0.6);
+  EXPECT_DOUBLE_EQ(with->gray_sigma_scale, 0.8);
+  EXPECT_DOUBLE_EQ(with->gray_max_valid_sigma_rad, 0.55);
 }
 
 // Median azimuth error of `model` over the held-out frames, fed colour or grey images.
@@ -358,6 +420,9 @@ TEST(SunCnnEstimator, RejectsWrongInput) {
         {"{ \"input\": { \"width\": 1e300 } }", "'input.width'"},
         {"{ \"mc\": { \"rows\": 2.5 } }", "'mc.rows'"},
         {"{ \"sigma_scale\": .nan }", "'sigma_scale'"},
+        {"{ \"gray_input\": 0.7 }", "'gray_input'"},
+        {"{ \"gray_input\": { \"sigma_scale\": \"x\" } }", "'gray_input.sigma_scale'"},
+        {"{ \"gray_input\": { \"max_valid_sigma_rad\": -1 } }", "gray_max_valid_sigma_rad"},
         {"{ \"input\": { \"width\": 208", "line 1"},
         {"[1, 2]", "not a JSON object"}}) {
     std::ofstream(dir + "/fuzzed.json") << text;

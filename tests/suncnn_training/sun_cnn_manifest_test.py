@@ -240,6 +240,24 @@ class EndToEnd(Base):
         self.assertIn(name, p.stderr)  # the held-out report names the real scenario
         model = os.path.join(model_dir, "sun_cnn.onnx")
         self.assertGreater(os.path.getsize(model), 1000)
+        with open(os.path.join(model_dir, "sun_cnn.json")) as f:
+            grey = json.load(f)["gray_input"]  # a colour model's calibration for grey cameras
+        self.assertGreater(grey["sigma_scale"], 0.0)
+        self.assertIn("val", grey["results"])
+        # sun_cnn_calibrate.py --grey-only re-chooses the grey numbers and keeps the colour ones.
+        with open(os.path.join(model_dir, "sun_cnn.json")) as f:
+            before = json.load(f)
+        p = subprocess.run([sys.executable, os.path.join(os.path.dirname(ARGS.trainer),
+                                                         "sun_cnn_calibrate.py"),
+                            "--manifest", manifest, "--model", model, "--grey-only"],
+                           capture_output=True, text=True)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertIn("grey input: sigma_scale", p.stderr)
+        with open(os.path.join(model_dir, "sun_cnn.json")) as f:
+            after = json.load(f)
+        for key in ("sigma_scale", "max_valid_sigma_rad", "results"):
+            self.assertEqual(after[key], before[key], key)
+        self.assertGreater(after["gray_input"]["sigma_scale"], 0.0)
         out = os.path.join(self.work, "eval")
         p = subprocess.run([ARGS.sun_eval, "--images", ARGS.frames, "--estimators", "sun_cnn",
                             "--model", model, "--out", out, "--debug", "0"],

@@ -41,6 +41,10 @@ Status SunCnnOptions::validate() const {
     return range("sigma_max_rad", "[sigma_min_rad, 10]");
   if (!(max_valid_sigma_rad > 0.0 && max_valid_sigma_rad <= 10.0))
     return range("max_valid_sigma_rad", "(0, 10]");
+  if (!(gray_sigma_scale > 0.0 && gray_sigma_scale <= 100.0))
+    return range("gray_sigma_scale", "(0, 100]");
+  if (!(gray_max_valid_sigma_rad > 0.0 && gray_max_valid_sigma_rad <= 10.0))
+    return range("gray_max_valid_sigma_rad", "(0, 10]");
   if (!(max_up_tilt_deg >= 0.0 && max_up_tilt_deg <= 90.0))
     return range("max_up_tilt_deg", "[0, 90]");
   return Status::ok();
@@ -214,9 +218,13 @@ Expected<sunfusion::ImageSunEstimate> SunCnnEstimator::estimate(
   const bool finite = std::isfinite(raw.c) && std::isfinite(raw.s);
   if (!finite) raw.c = raw.s = 0.0;  // no direction; sigma goes to its cap below
   raw.r_al = std::min(std::hypot(raw.c, raw.s), 1.0);
-  raw.sigma_rad = std::clamp(
-      o.sigma_scale * std::sqrt(circularStdSquared(raw.r_mc) + circularStdSquared(raw.r_al)),
-      o.sigma_min_rad, o.sigma_max_rad);
+  raw.gray_calibration = grey_in && o.input_channels == 3;
+  const double scale = raw.gray_calibration ? o.gray_sigma_scale : o.sigma_scale;
+  const double max_valid =
+      raw.gray_calibration ? o.gray_max_valid_sigma_rad : o.max_valid_sigma_rad;
+  raw.sigma_rad =
+      std::clamp(scale * std::sqrt(circularStdSquared(raw.r_mc) + circularStdSquared(raw.r_al)),
+                 o.sigma_min_rad, o.sigma_max_rad);
   raw_ = raw;
 
   sunfusion::ImageSunEstimate e;
@@ -235,7 +243,7 @@ Expected<sunfusion::ImageSunEstimate> SunCnnEstimator::estimate(
     upright = n > 1e-9 && std::isfinite(n) &&
               std::acos(std::clamp(-up_c.y() / n, -1.0, 1.0)) * kRadToDeg <= o.max_up_tilt_deg;
   }
-  e.valid = finite && upright && raw.sigma_rad <= o.max_valid_sigma_rad;
+  e.valid = finite && upright && raw.sigma_rad <= max_valid;
   e.time_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return e;

@@ -79,6 +79,15 @@ Expected<SunCnnOptions> loadSunCnnOptions(const std::string& json_path, const Su
     num(mc, "dropout_p", "mc.dropout_p", o.dropout_p);
     num(root, "sigma_scale", "sigma_scale", o.sigma_scale);
     num(root, "max_valid_sigma_rad", "max_valid_sigma_rad", o.max_valid_sigma_rad);
+    // Grey images on a colour model: their own calibration where the JSON has one, else the
+    // colour calibration (a model calibrated before grey inputs had their own numbers).
+    const YAML::Node gray = section("gray_input");
+    if (gray.size() == 0) {
+      o.gray_sigma_scale = o.sigma_scale;
+      o.gray_max_valid_sigma_rad = o.max_valid_sigma_rad;
+    }
+    num(gray, "sigma_scale", "gray_input.sigma_scale", o.gray_sigma_scale);
+    num(gray, "max_valid_sigma_rad", "gray_input.max_valid_sigma_rad", o.gray_max_valid_sigma_rad);
   } catch (const YAML::Exception& e) {
     return parseError("suncnn: " + json_path + ": " + e.what());
   }

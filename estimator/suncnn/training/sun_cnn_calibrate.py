@@ -5,6 +5,9 @@ max_valid_sigma_rad, results per split). The model runs through OpenCV's DNN, as
 image -> INTER_AREA resize -> planes -> 16 MC mask rows per member (numpy masks).
 
     sun_cnn_calibrate.py --manifest /work/renders/sun_cnn_manifest.csv --model config/sun_cnn.onnx
+
+A colour model gets a second calibration, "gray_input": the same choice for the validation
+images as a grey camera gives them to it, (Y, Y, Y) (--grey-only: that one alone).
 """
 import argparse
 import json
@@ -20,8 +23,9 @@ from sun_cnn_train import LUMA, load, report, signed_deg, targets
 SAMPLES = 16
 
 
-def run_model(net, meta, images, rng):
-    """[M, n, 2] deterministic outputs and [M, n, S, 2] MC samples of the ONNX model."""
+def run_model(net, meta, images, rng, grey_in=False):
+    """[M, n, 2] deterministic outputs and [M, n, S, 2] MC samples of the ONNX model; grey_in:
+    the images as a grey camera gives them to a colour model, (Y, Y, Y)."""
     ch, members = meta["input"]["channels"], meta["mc"]["members"]
     rows, f, d = meta["mc"]["rows"], meta["mc"]["mask1"], meta["mc"]["mask2"]
     keep = 1.0 / (1.0 - DROPOUT_P)
@@ -31,6 +35,8 @@ def run_model(net, meta, images, rng):
         small = cv2.resize(img, (IN_W, IN_H), interpolation=cv2.INTER_AREA).astype(np.float32)
         if ch == 1:
             small = (small @ LUMA)[..., None]
+        elif grey_in:
+            small = np.repeat((small @ LUMA)[..., None], 3, axis=-1)
         blob = ((small / 255.0 - MEAN) / STD).transpose(2, 0, 1)[None].copy()
         m1 = np.ones((rows, f), np.float32)
         m2 = np.ones((rows, d), np.float32)
@@ -50,6 +56,8 @@ def main():
     ap.add_argument("--manifest", required=True)
     ap.add_argument("--model", required=True)
     ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--grey-only", action="store_true",
+                    help="a colour model: choose only the grey-input numbers, keep the colour ones")
     a = ap.parse_args()
     cv2.setNumThreads(1)
     json_path = os.path.splitext(a.model)[0] + ".json"
@@ -58,30 +66,51 @@ def main():
     net = cv2.dnn.readNetFromONNX(a.model)
     data = load(a.manifest)
     rng = np.random.default_rng(a.seed)
-    evals = {}
-    for split, (x, sun, scen) in data.items():
-        t, w = targets(sun)
-        keep = w > 0
-        v, raw = combine(*run_model(net, meta, x[keep], rng))
-        evals[split] = (signed_deg(v, t[keep]), raw, np.array(scen)[keep])
-    if "val" not in evals:
+    if "val" not in data:
         raise SystemExit(f"{a.manifest}: no validation rows to calibrate on")
-    scale, threshold = calibrate(evals["val"][0], evals["val"][1])
-    meta["sigma_scale"], meta["max_valid_sigma_rad"] = scale, threshold
-    meta["results"] = {k: report(e, r, s, scale, threshold) for k, (e, r, s) in evals.items()}
+
+    def calibrated(grey_in, splits, rng):
+        evals = {}
+        for split in splits:
+            x, sun, scen = data[split]
+            t, w = targets(sun)
+            keep = w > 0
+            v, raw = combine(*run_model(net, meta, x[keep], rng, grey_in))
+            evals[split] = (signed_deg(v, t[keep]), raw, np.array(scen)[keep])
+        scale, threshold = calibrate(evals["val"][0], evals["val"][1])
+        return scale, threshold, {k: report(e, r, s, scale, threshold)
+                                  for k, (e, r, s) in evals.items()}
+
+    if a.grey_only and meta["input"]["channels"] != 3:
+        raise SystemExit(f"{a.model}: --grey-only needs a colour model")
+    if not a.grey_only:
+        scale, threshold, meta["results"] = calibrated(False, list(data), rng)
+        meta["sigma_scale"], meta["max_valid_sigma_rad"] = scale, threshold
+    if meta["input"]["channels"] == 3:
+        # Grey cameras fed to this colour model as (Y, Y, Y): their own threshold and scale, with
+        # masks of their own (the same whatever training rows the manifest lists).
+        g_scale, g_threshold, g_results = calibrated(
+            True, [k for k in data if k != "train"], np.random.default_rng([a.seed, 1]))
+        meta["gray_input"] = {"sigma_scale": g_scale, "max_valid_sigma_rad": g_threshold,
+                              "results": g_results}
     meta["calibration"] = ("sun_cnn_calibrate.py: threshold flags 90 % of the validation gross "
                            "errors; scale puts 95 % of the valid validation frames within 2 sigma")
     with open(json_path, "w") as f:
         json.dump(meta, f, indent=2)
         f.write("\n")
-    for split, r in meta["results"].items():
+    for split, r in list(meta["results"].items()) + [
+            ("grey " + k, v) for k, v in meta.get("gray_input", {}).get("results", {}).items()]:
         m = r["all"]
         print(f"{split}: median {m['median_deg']:.1f} deg, gross {100 * m['gross_share']:.1f} %, "
               f"valid {100 * m['valid_share']:.0f} %, gross flagged "
               f"{100 * m.get('gross_flagged_share', float('nan')):.0f} %, within 2 sigma "
               f"{100 * m.get('within_2sigma_share', float('nan')):.0f} %", file=sys.stderr)
-    print(f"{json_path}: sigma_scale {scale:.4f}, max_valid_sigma_rad {threshold:.4f}",
-          file=sys.stderr)
+    print(f"{json_path}: sigma_scale {meta['sigma_scale']:.4f}, max_valid_sigma_rad "
+          f"{meta['max_valid_sigma_rad']:.4f}", file=sys.stderr)
+    if "gray_input" in meta:
+        g = meta["gray_input"]
+        print(f"{json_path}: grey input: sigma_scale {g['sigma_scale']:.4f}, max_valid_sigma_rad "
+              f"{g['max_valid_sigma_rad']:.4f}", file=sys.stderr)
 
 
 if __name__ == "__main__":

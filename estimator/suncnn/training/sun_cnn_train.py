@@ -75,6 +75,13 @@ def to_input(bgr_float, channels):
     return x.mul_(1.0 / (255.0 * STD)).sub_(MEAN / STD)
 
 
+def grey_as_colour(u8):
+    """N,H,W,3 uint8 BGR -> what a grey camera gives a colour model: the BT.601 luma, rounded to
+    8 bits, in all three channels (the C++ estimator feeds a grey image as (Y, Y, Y))."""
+    y = np.clip(np.rint(u8.astype(np.float32) @ LUMA), 0, 255).astype(np.uint8)
+    return np.repeat(y[..., None], 3, axis=-1)
+
+
 def plain(u8, channels):
     """Evaluation input: the whole image resized as the C++ side does (INTER_AREA)."""
     small = np.stack([cv2.resize(im, (IN_W, IN_H), interpolation=cv2.INTER_AREA) for im in u8])
@@ -303,7 +310,20 @@ def main():
         if split in data:
             err, raw, scen = evaluate(members, data[split], a.channels, a.seed)
             results[split] = report(err, raw, scen, scale, threshold)
-    for split, r in results.items():
+    # A colour model also serves grey cameras, fed (Y, Y, Y): their answers get their own
+    # threshold and scale, chosen the same way on the validation rows' luma.
+    gray_input = {}
+    if a.channels == 3 and "val" in data:
+        grey = {k: (grey_as_colour(v[0]), v[1], v[2]) for k, v in data.items() if k != "train"}
+        err, raw, scen = evaluate(members, grey["val"], 3, a.seed)
+        g_scale, g_threshold = calibrate(err, raw)
+        gray_input = {"sigma_scale": g_scale, "max_valid_sigma_rad": g_threshold, "results": {}}
+        for split in ("val", "test"):
+            if split in grey:
+                err, raw, scen = evaluate(members, grey[split], 3, a.seed)
+                gray_input["results"][split] = report(err, raw, scen, g_scale, g_threshold)
+    for split, r in list(results.items()) + [
+            ("grey " + k, v) for k, v in gray_input.get("results", {}).items()]:
         for scenario, m in r.items():
             log(f"{split} {scenario}: median {m['median_deg']:.1f} deg, p90 {m['p90_deg']:.1f}, "
                 f"bias {m['signed_median_deg']:+.1f}, gross {100 * m['gross_share']:.1f} %, "
@@ -343,6 +363,7 @@ def main():
         "seed": a.seed,
         "train_seconds": round(train_s, 1),
         "results": results,
+        **({"gray_input": gray_input} if gray_input else {}),
         "date": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
         "torch": torch.__version__,
     }

@@ -60,15 +60,23 @@ struct SunCnnOptions {
   double max_valid_sigma_rad = 0.4051;  // above this the estimate is returned with
                                         // valid = false, rad, (0, 10]; chosen on the validation
                                         // renders (config/sun_cnn.json)
-  double max_up_tilt_deg = 30.0;        // valid = false when the prior's "up" is further than this
+  // The same two numbers for a grey image fed to a colour model as (Y, Y, Y) (grey V4L2 or
+  // KITTI cameras 0/1): its answers are a little less sure than on colour images, so they get
+  // their own calibration, chosen on the validation renders' grey luma (config/sun_cnn.json,
+  // "gray_input"). A JSON without that section gives them the colour values. Unused by a grey
+  // model (input_channels 1).
+  double gray_sigma_scale = 0.6817;          // (0, 100]
+  double gray_max_valid_sigma_rad = 0.5528;  // rad, (0, 10]
+  double max_up_tilt_deg = 30.0;  // valid = false when the prior's "up" is further than this
                                   // from the camera's -y (the azimuth is in the x-z plane), deg,
                                   // [0, 90]; ignored without a prior
-  std::uint64_t seed = 1;   // RNG of the dropout masks
-  Status validate() const;  // names the bad key ("suncnn.mc_samples ...")
+  std::uint64_t seed = 1;         // RNG of the dropout masks
+  Status validate() const;        // names the bad key ("suncnn.mc_samples ...")
 };
 
 // The JSON the training script writes beside a model (<model>.json): the input size and
-// channels, ensemble members, mask sizes, dropout, sigma_scale and max_valid_sigma_rad, over
+// channels, ensemble members, mask sizes, dropout, sigma_scale and max_valid_sigma_rad (and for
+// a colour model gray_input.sigma_scale and gray_input.max_valid_sigma_rad), over
 // `base` (keys it lacks keep base's values). Errors name the file and the key.
 Expected<SunCnnOptions> loadSunCnnOptions(const std::string& json_path,
                                           const SunCnnOptions& base = {});
@@ -80,10 +88,11 @@ Expected<SunCnnOptions> optionsForModel(const std::string& model_path);
 
 // The raw network answer for one image, before the uncertainty is turned into a measurement.
 struct SunCnnRaw {
-  double c = 0.0, s = 0.0;  // deterministic output (dropout off)
-  double r_mc = 1.0;        // mean resultant length of the MC sample directions, [0, 1]
-  double r_al = 0.0;        // length of the deterministic output, clamped to [0, 1]
-  double sigma_rad = 0.0;   // after scale and clamp
+  double c = 0.0, s = 0.0;        // deterministic output (dropout off)
+  double r_mc = 1.0;              // mean resultant length of the MC sample directions, [0, 1]
+  double r_al = 0.0;              // length of the deterministic output, clamped to [0, 1]
+  double sigma_rad = 0.0;         // after scale and clamp
+  bool gray_calibration = false;  // a grey image on a colour model: the gray_* numbers applied
 };
 
 class SunCnnEstimator : public sunfusion::ImageSunEstimator {
