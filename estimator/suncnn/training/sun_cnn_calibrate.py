@@ -88,9 +88,10 @@ def main():
         meta["sigma_scale"], meta["max_valid_sigma_rad"] = scale, threshold
     if meta["input"]["channels"] == 3:
         # Grey cameras fed to this colour model as (Y, Y, Y): their own threshold and scale, with
-        # masks of their own (the same whatever training rows the manifest lists).
+        # masks of their own, validation first (the same whatever other rows the manifest lists).
         g_scale, g_threshold, g_results = calibrated(
-            True, [k for k in data if k != "train"], np.random.default_rng([a.seed, 1]))
+            True, ["val"] + [k for k in data if k not in ("train", "val")],
+            np.random.default_rng([a.seed, 1]))
         meta["gray_input"] = {"sigma_scale": g_scale, "max_valid_sigma_rad": g_threshold,
                               "results": g_results}
     meta["calibration"] = ("sun_cnn_calibrate.py: threshold flags 90 % of the validation gross "

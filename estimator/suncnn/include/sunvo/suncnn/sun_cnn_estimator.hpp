@@ -65,8 +65,8 @@ struct SunCnnOptions {
   // their own calibration, chosen on the validation renders' grey luma (config/sun_cnn.json,
   // "gray_input"). A JSON without that section gives them the colour values. Unused by a grey
   // model (input_channels 1).
-  double gray_sigma_scale = 0.6817;          // (0, 100]
-  double gray_max_valid_sigma_rad = 0.5528;  // rad, (0, 10]
+  double gray_sigma_scale = 0.6807;          // (0, 100]
+  double gray_max_valid_sigma_rad = 0.5501;  // rad, (0, 10]
   double max_up_tilt_deg = 30.0;  // valid = false when the prior's "up" is further than this
                                   // from the camera's -y (the azimuth is in the x-z plane), deg,
                                   // [0, 90]; ignored without a prior
