@@ -258,6 +258,20 @@ class EndToEnd(Base):
         for key in ("sigma_scale", "max_valid_sigma_rad", "results"):
             self.assertEqual(after[key], before[key], key)
         self.assertGreater(after["gray_input"]["sigma_scale"], 0.0)
+        # A full re-calibration on a manifest without the training rows: the training split keeps
+        # its old scores, under a name that says so.
+        val_only = os.path.join(self.work, "manifest_val.csv")
+        with open(manifest) as f, open(val_only, "w") as g:
+            g.writelines(line for line in f if not line.startswith("train,"))
+        p = subprocess.run([sys.executable, os.path.join(os.path.dirname(ARGS.trainer),
+                                                         "sun_cnn_calibrate.py"),
+                            "--manifest", val_only, "--model", model],
+                           capture_output=True, text=True)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        with open(os.path.join(model_dir, "sun_cnn.json")) as f:
+            recal = json.load(f)
+        self.assertEqual(sorted(recal["results"]), ["val"])
+        self.assertEqual(recal["results_previous_calibration"]["train"], before["results"]["train"])
         out = os.path.join(self.work, "eval")
         p = subprocess.run([ARGS.sun_eval, "--images", ARGS.frames, "--estimators", "sun_cnn",
                             "--model", model, "--out", out, "--debug", "0"],

@@ -7,7 +7,8 @@ image -> INTER_AREA resize -> planes -> 16 MC mask rows per member (numpy masks)
     sun_cnn_calibrate.py --manifest /work/renders/sun_cnn_manifest.csv --model config/sun_cnn.onnx
 
 A colour model gets a second calibration, "gray_input": the same choice for the validation
-images as a grey camera gives them to it, (Y, Y, Y) (--grey-only: that one alone).
+images as a grey camera gives them to it, (Y, Y, Y) (--grey-only: that one alone). Splits the
+manifest does not list keep their old scores under "results_previous_calibration".
 """
 import argparse
 import json
@@ -84,8 +85,19 @@ def main():
     if a.grey_only and meta["input"]["channels"] != 3:
         raise SystemExit(f"{a.model}: --grey-only needs a colour model")
     if not a.grey_only:
-        scale, threshold, meta["results"] = calibrated(False, list(data), rng)
+        # Validation first: the masks it draws do not depend on the other rows listed.
+        scale, threshold, scored = calibrated(
+            False, ["val"] + [k for k in data if k != "val"], rng)
         meta["sigma_scale"], meta["max_valid_sigma_rad"] = scale, threshold
+        # A split the manifest does not list (e.g. the training renders, not at hand) keeps its
+        # old scores, under a name that says they belong to the previous calibration.
+        old = {k: v for k, v in meta.get("results", {}).items() if k not in scored}
+        old.update({k: v for k, v in meta.get("results_previous_calibration", {}).items()
+                    if k not in scored and k not in old})
+        meta["results"] = scored
+        meta.pop("results_previous_calibration", None)
+        if old:
+            meta["results_previous_calibration"] = old
     if meta["input"]["channels"] == 3:
         # Grey cameras fed to this colour model as (Y, Y, Y): their own threshold and scale, with
         # masks of their own, validation first (the same whatever other rows the manifest lists).

@@ -53,11 +53,11 @@ struct SunCnnOptions {
   int mask2_size = 128;         // D, hidden units into the second FC layer, must match, [1, 1e6]
   double dropout_p = 0.3;       // dropout probability used in training, [0, 0.9]
   int mc_samples = 16;          // N, MC dropout samples per image, [0, mask_rows - 1]; 0: R_mc = 1
-  double sigma_scale = 0.5048;  // calibration factor on the spread sigma, (0, 100]; fitted
+  double sigma_scale = 0.8341;  // calibration factor on the spread sigma, (0, 100]; fitted
                                 // on the validation renders (config/sun_cnn.json)
   double sigma_min_rad = 0.03;  // floor of the reported sigma, rad, [0, 1]
   double sigma_max_rad = 3.0;   // cap of the reported sigma, rad, [sigma_min_rad, 10]
-  double max_valid_sigma_rad = 0.4051;  // above this the estimate is returned with
+  double max_valid_sigma_rad = 0.5869;  // above this the estimate is returned with
                                         // valid = false, rad, (0, 10]; chosen on the validation
                                         // renders (config/sun_cnn.json)
   // The same two numbers for a grey image fed to a colour model as (Y, Y, Y) (grey V4L2 or
@@ -65,8 +65,8 @@ struct SunCnnOptions {
   // their own calibration, chosen on the validation renders' grey luma (config/sun_cnn.json,
   // "gray_input"). A JSON without that section gives them the colour values. Unused by a grey
   // model (input_channels 1).
-  double gray_sigma_scale = 0.6807;          // (0, 100]
-  double gray_max_valid_sigma_rad = 0.5501;  // rad, (0, 10]
+  double gray_sigma_scale = 0.8073;          // (0, 100]
+  double gray_max_valid_sigma_rad = 0.6505;  // rad, (0, 10]
   double max_up_tilt_deg = 30.0;  // valid = false when the prior's "up" is further than this
                                   // from the camera's -y (the azimuth is in the x-z plane), deg,
                                   // [0, 90]; ignored without a prior
