@@ -91,11 +91,9 @@ def main():
         meta["sigma_scale"], meta["max_valid_sigma_rad"] = scale, threshold
         # A split the manifest does not list (e.g. the training renders, not at hand) keeps its
         # old scores, under a name that says they belong to the previous calibration.
-        old = {k: v for k, v in meta.get("results", {}).items() if k not in scored}
-        old.update({k: v for k, v in meta.get("results_previous_calibration", {}).items()
-                    if k not in scored and k not in old})
+        old = {**meta.pop("results_previous_calibration", {}), **meta.get("results", {})}
+        old = {k: v for k, v in old.items() if k not in scored}
         meta["results"] = scored
-        meta.pop("results_previous_calibration", None)
         if old:
             meta["results_previous_calibration"] = old
     if meta["input"]["channels"] == 3:

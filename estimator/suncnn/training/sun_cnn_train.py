@@ -314,14 +314,11 @@ def main():
     # threshold and scale, chosen the same way on the validation rows' luma.
     gray_input = {}
     if a.channels == 3 and "val" in data:
-        grey = {k: (grey_as_colour(v[0]), v[1], v[2]) for k, v in data.items() if k != "train"}
-        err, raw, scen = evaluate(members, grey["val"], 3, a.seed)
-        g_scale, g_threshold = calibrate(err, raw)
-        gray_input = {"sigma_scale": g_scale, "max_valid_sigma_rad": g_threshold, "results": {}}
-        for split in ("val", "test"):
-            if split in grey:
-                err, raw, scen = evaluate(members, grey[split], 3, a.seed)
-                gray_input["results"][split] = report(err, raw, scen, g_scale, g_threshold)
+        g_evals = {k: evaluate(members, (grey_as_colour(data[k][0]),) + data[k][1:], 3, a.seed)
+                   for k in ("val", "test") if k in data}
+        g_scale, g_threshold = calibrate(*g_evals["val"][:2])
+        gray_input = {"sigma_scale": g_scale, "max_valid_sigma_rad": g_threshold,
+                      "results": {k: report(*e, g_scale, g_threshold) for k, e in g_evals.items()}}
     for split, r in list(results.items()) + [
             ("grey " + k, v) for k, v in gray_input.get("results", {}).items()]:
         for scenario, m in r.items():
