@@ -4,8 +4,20 @@
 #include <chrono>
 #include <string>
 
+#include "sunvo/core/geometry.hpp"
+
 namespace sunvo::vo {
 namespace {
+
+// The pose with its rotation put back on SO(3). Poses are chained through Isometry3::inverse(),
+// which transposes the rotation; a pose that is not quite a rotation leaves its error in every
+// product. A loss chains three of them (the last motion from two poses, the prediction from it),
+// and without this the error |C C^T - I| tripled with every loss: 0020's real tracks with a third
+// of the landmarks reached 1.5e-2 after 40 losses, positions of 1e118 m and NaN after 70.
+Isometry3 rigid(Isometry3 T) {
+  T.linear() = orthonormalize(T.linear());
+  return T;
+}
 
 double msSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -198,7 +210,7 @@ Expected<VoResult> StereoTrackOdometry::process(const FrameFeatures& frame) {
     const Isometry3 motion =
         options_.constant_velocity_on_loss ? last_motion_ : Isometry3::Identity();
     r.T_k_km1 = motion;
-    r.T_w_c = T_w_last_ * motion.inverse();
+    r.T_w_c = rigid(T_w_last_ * motion.inverse());
     r.status = TrackingStatus::kLost;
     T_w_last_ = r.T_w_c;
     store(lost_frame_, frame, r.T_w_c);
@@ -255,12 +267,13 @@ Expected<VoResult> StereoTrackOdometry::process(const FrameFeatures& frame) {
     r.window_ms = msSince(t_window);
   }
   if (!allFinite(T_w_k)) T_w_k = ref->T_w_c * est.T_k_km1.inverse();
+  T_w_k = rigid(T_w_k);
 
   r.T_k_km1 = T_w_k.inverse() * T_w_last_;
   r.T_w_c = T_w_k;
   r.status = lost_ ? TrackingStatus::kRecovered : TrackingStatus::kTracking;
   if (r.reference_gap == 1) {
-    last_motion_ = T_w_k.inverse() * ref->T_w_c;
+    last_motion_ = rigid(T_w_k.inverse() * ref->T_w_c);
     have_motion_ = true;
   }
   lost_ = false;
