@@ -69,10 +69,8 @@ int main(int argc, char** argv) {
   app.add_option("--max-time", win.max_solver_time_in_seconds, "Ceres time per frame, s");
   double min_disparity = opt.ransac.min_disparity_px;
   app.add_option("--min-disparity", min_disparity, "smallest disparity used, px");
-  app.add_option("--prior-rot-deg", win.motion_prior_sigma_rot_deg, "motion prior, deg");
-  app.add_option("--prior-trans-m", win.motion_prior_sigma_trans_m, "motion prior, m");
   app.add_option("--seed", opt.seed, "RANSAC seed");
-  sunvo::cli::addRotationRatePriorOptions(app, win);
+  sunvo::cli::addWindowPriorOptions(app, win);
   app.add_option("--log", args.log_path, "per-frame CSV log");
   sunvo::selfcal::StereoSelfCalibrationOptions selfcal_opt;  // issue 15: off unless --self-calib
   app.add_flag("--self-calib", selfcal_opt.enabled,

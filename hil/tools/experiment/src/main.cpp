@@ -89,7 +89,7 @@ int main(int argc, char** argv) {
                  "comma-separated fusion forms, each a column per source: sunvo (the base "
                  "attitude is estimated), paper (held fixed, as the paper did)");
   app.add_flag("--fixed-drift", fixed_drift, "keep the random walk at --drift-deg");
-  sunvo::cli::addRotationRatePriorOptions(app, options.vo.window);
+  sunvo::cli::addWindowPriorOptions(app, options.vo.window);
   bool vertical = false;
   // The vertical-like source (docs/vertical.md): 1 deg per axis, as the cue's spread on real
   // KITTI frames; 10 % of 8 deg outliers; half the cue frames without an answer.

@@ -54,12 +54,21 @@ CLI::Option* addEnumOption(CLI::App& app, const std::string& name, E& value,
       ->check(CLI::IsMember(choices));
 }
 
-// The window's rotation-rate prior switches (backend::WindowOptions, docs/backend.md), the same
-// in every program that runs the back end: --no-rate-prior, --rate-prior-pitch/-yaw/-roll
-// (deg/s), --rate-prior-adapt-frames, --yaw-axis-memory-s, --yaw-axis-prior-deg. A template so that
-// this library needs nothing of the back end.
+// The window's motion priors (backend::WindowOptions, docs/backend.md), the same in every program
+// that runs the back end: the constant-velocity prior's --prior-rot-deg and --prior-trans-m (per
+// frame; 0 and 0 = off), and the rotation-rate prior's --no-rate-prior,
+// --rate-prior-pitch/-yaw/-roll (deg/s), --rate-prior-adapt-frames, --yaw-axis-memory-s,
+// --yaw-axis-prior-deg. A template so that this library needs nothing of the back end.
 template <class WindowOptions>
-void addRotationRatePriorOptions(CLI::App& app, WindowOptions& win) {
+void addWindowPriorOptions(CLI::App& app, WindowOptions& win) {
+  app.add_option("--prior-rot-deg", win.motion_prior_sigma_rot_deg,
+                 "constant-velocity prior: std of a frame's rotation about the last motion's, deg "
+                 "(window.motion_prior_sigma_rot_deg; 0 with --prior-trans-m 0 = off)")
+      ->check(CLI::Range(0.0, 180.0));
+  app.add_option("--prior-trans-m", win.motion_prior_sigma_trans_m,
+                 "constant-velocity prior: std of a frame's translation about the last motion's, m "
+                 "(window.motion_prior_sigma_trans_m)")
+      ->check(CLI::Range(0.0, 1000.0));
   app.add_flag(
       "!--no-rate-prior", win.rotation_rate_prior,
       "VO without the window's zero-mean rotation-rate prior (window.rotation_rate_prior)");
