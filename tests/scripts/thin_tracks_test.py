@@ -49,11 +49,12 @@ class ThinTracks(unittest.TestCase):
                 self.assertEqual(sum(1 for _, x in rows if x == lm), FRAMES)
             for name in ("calib.txt", "times.txt"):
                 self.assertTrue(os.path.isfile(os.path.join(out, name)))
-            again = os.path.join(d, "again")
-            self.assertEqual(self.run_script(src, again, "--keep", "0.3", "--seed", "4").returncode, 0)
-            self.assertEqual(self.read(again), rows)
-            other = os.path.join(d, "other")
-            self.assertEqual(self.run_script(src, other, "--keep", "0.3", "--seed", "5").returncode, 0)
+            again, other = os.path.join(d, "again"), os.path.join(d, "other")
+            r = self.run_script(src, again, "--keep", "0.3", "--seed", "4")
+            self.assertEqual(r.returncode, 0, r.stderr)
+            self.assertEqual(self.read(again), rows)  # the same seed, the same landmarks
+            r = self.run_script(src, other, "--keep", "0.3", "--seed", "5")
+            self.assertEqual(r.returncode, 0, r.stderr)
             self.assertNotEqual(self.read(other), rows)
 
     def test_bad_input_names_the_file(self):
