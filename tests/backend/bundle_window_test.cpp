@@ -265,6 +265,7 @@ TEST(BundleWindow, MotionPriorPullsTowardThePrediction) {
   WindowOptions wo;
   wo.max_num_iterations = 50;
   wo.max_solver_time_in_seconds = 10.0;  // bounded by iterations (slow under qemu-aarch64)
+  wo.motion_prior_sigma_accel_m_s2 = 0.0;
   {
     BundleWindow w;  // prior disabled: the data wins
     twoFrames(w, wo, T_1_0, &predicted);
@@ -284,8 +285,53 @@ TEST(BundleWindow, MotionPriorPullsTowardThePrediction) {
     EXPECT_LT(testing::rotationErrorDeg(w.T_k_b(1), predicted), 1e-3);
     EXPECT_LT((w.T_k_b(1).translation() - predicted.translation()).norm(), 1e-3);
   }
+  wo.motion_prior_sigma_accel_m_s2 = 7.0;  // the per-frame and the acceleration form exclude
+  EXPECT_NE(wo.validate().message().find("window.motion_prior_sigma_accel_m_s2"),
+            std::string::npos);
+  wo.motion_prior_sigma_accel_m_s2 = -1.0;
   wo.motion_prior_sigma_trans_m = 0.0;
-  EXPECT_NE(wo.validate().message().find("window.motion_prior_sigma"), std::string::npos);
+  EXPECT_NE(wo.validate().message().find("window.motion_prior_sigma_accel_m_s2"),
+            std::string::npos);
+}
+
+// The acceleration form holds the translation to the prediction's with std sigma_a dt^2 and leaves
+// the rotation to the data; without a frame interval (dt <= 0) it adds nothing.
+TEST(BundleWindow, AccelerationPriorHoldsTheTranslationAndLeavesTheRotation) {
+  const Isometry3 T_1_0 = testing::forwardMotion(1.0, 1.0);
+  Isometry3 predicted = T_1_0;
+  predicted.linear() = expSO3(Eigen::Vector3d(0.0, 0.5 * M_PI / 180.0, 0.0)) * predicted.linear();
+  predicted.translation() += Eigen::Vector3d(0.1, 0.0, 0.2);
+  WindowOptions wo;
+  wo.max_num_iterations = 50;
+  wo.max_solver_time_in_seconds = 10.0;
+  ASSERT_EQ(wo.motion_prior_sigma_rot_deg, 0.0);  // the default: translation only
+  ASSERT_GT(wo.motion_prior_sigma_accel_m_s2, 0.0);
+  wo.motion_prior_sigma_accel_m_s2 = 1e-4;  // 1e-6 m over the frames' 0.1 s: the prediction wins
+  BundleWindow w;
+  twoFrames(w, wo, T_1_0, &predicted);
+  auto s = w.solve();
+  ASSERT_TRUE(s);
+  EXPECT_EQ(s->num_prior_residuals, 1);
+  EXPECT_LT((w.T_k_b(1).translation() - predicted.translation()).norm(), 1e-3);
+  // The rotation follows the tracks, not the prediction's 0.5 deg.
+  EXPECT_GT(testing::rotationErrorDeg(w.T_k_b(1), predicted), 0.2);
+
+  // Two frames with the same time: no interval, no prior.
+  const auto cam = kittiCamera();
+  testing::SceneOptions so;
+  so.pixel_noise_px = 0.0;
+  const auto pts = testing::makeLandmarks(so, 2.0);
+  BundleWindow same;
+  ASSERT_TRUE(same.init(wo, cam).isOk());
+  same.reset(Isometry3::Identity());
+  const auto f0 = testing::observe(cam, pts, Isometry3::Identity(), 0, so);
+  const auto f1 = testing::observe(cam, pts, T_1_0, 1, so);
+  ASSERT_TRUE(same.addFrame(0, f0.time_ns, toWindow(f0), Isometry3::Identity()).isOk());
+  ASSERT_TRUE(same.addFrame(1, f0.time_ns, toWindow(f1), T_1_0, &predicted).isOk());
+  auto s2 = same.solve();
+  ASSERT_TRUE(s2);
+  EXPECT_EQ(s2->num_prior_residuals, 0);
+  EXPECT_LT(testing::rotationErrorDeg(same.T_k_b(1), T_1_0), 1e-3);
 }
 
 TEST(BundleWindow, DegenerateInputFailsWithoutTouchingThePoses) {

@@ -96,6 +96,7 @@ Result run(const Scenario& sc, WindowSolver solver, int frames = 6) {
   if (sc.with_prior) {
     wo.motion_prior_sigma_rot_deg = 0.2;
     wo.motion_prior_sigma_trans_m = 0.05;
+    wo.motion_prior_sigma_accel_m_s2 = 0.0;  // the per-frame form instead
   }
   BundleWindow w;
   Result out;

@@ -35,10 +35,13 @@ Status WindowOptions::validate() const {
   if (!(motion_prior_sigma_trans_m >= 0.0)) {
     return invalidArgument("window.motion_prior_sigma_trans_m must be >= 0");
   }
-  if ((motion_prior_sigma_rot_deg > 0.0) != (motion_prior_sigma_trans_m > 0.0)) {
+  if (!(motion_prior_sigma_accel_m_s2 >= 0.0 && motion_prior_sigma_accel_m_s2 <= 1000.0)) {
+    return invalidArgument("window.motion_prior_sigma_accel_m_s2 must be in [0, 1000]");
+  }
+  if (motion_prior_sigma_trans_m > 0.0 && motion_prior_sigma_accel_m_s2 > 0.0) {
     return invalidArgument(
-        "window.motion_prior_sigma_rot_deg and window.motion_prior_sigma_trans_m must both be > 0 "
-        "or both 0");
+        "window.motion_prior_sigma_trans_m and window.motion_prior_sigma_accel_m_s2 are two forms "
+        "of one std: set one of them to 0");
   }
   for (const auto& [key, value] : {std::pair{"rate_prior_pitch_deg_s", rate_prior_pitch_deg_s},
                                    std::pair{"rate_prior_yaw_deg_s", rate_prior_yaw_deg_s},
@@ -220,7 +223,15 @@ Status BundleWindow::addFrame(std::uint64_t sequence, TimeNs time_ns,
   f.time_ns = time_ns;
   std::copy(obs.begin(), obs.end(), f.obs.begin());
   f.num_obs = static_cast<int>(obs.size());
-  f.has_prior = slot > 0 && motion_prior != nullptr && options_.motion_prior_sigma_rot_deg > 0.0 &&
+  // The translation std: per frame, or from the acceleration std over this frame's interval.
+  double s_trans = options_.motion_prior_sigma_trans_m;
+  if (slot > 0 && options_.motion_prior_sigma_accel_m_s2 > 0.0) {
+    const double dt =
+        1e-9 * static_cast<double>(time_ns - frames_[static_cast<std::size_t>(slot - 1)].time_ns);
+    s_trans = dt > 0.0 ? options_.motion_prior_sigma_accel_m_s2 * dt * dt : 0.0;
+  }
+  f.has_prior = slot > 0 && motion_prior != nullptr &&
+                (options_.motion_prior_sigma_rot_deg > 0.0 || s_trans > 0.0) &&
                 allFinite(*motion_prior);
   if (f.has_prior) {
     const Eigen::Quaterniond q(motion_prior->linear());
@@ -229,8 +240,10 @@ Status BundleWindow::addFrame(std::uint64_t sequence, TimeNs time_ns,
     f.prior.q_pred[2] = q.z();
     f.prior.q_pred[3] = q.w();
     for (int i = 0; i < 3; ++i) f.prior.t_pred[i] = motion_prior->translation()[i];
-    f.prior.sqrt_info_rot = 1.0 / (options_.motion_prior_sigma_rot_deg * M_PI / 180.0);
-    f.prior.sqrt_info_trans = 1.0 / options_.motion_prior_sigma_trans_m;
+    // A std of 0 leaves that part of the motion free (its rows weigh nothing).
+    const double s_rot = options_.motion_prior_sigma_rot_deg * M_PI / 180.0;
+    f.prior.sqrt_info_rot = s_rot > 0.0 ? 1.0 / s_rot : 0.0;
+    f.prior.sqrt_info_trans = s_trans > 0.0 ? 1.0 / s_trans : 0.0;
   }
   if (slot == 0) {
     poses_[0] = PoseBlock{};

@@ -69,9 +69,17 @@ struct WindowOptions {
   int max_num_iterations = 10;                   // count, [1, 1000]: solver iterations per solve
   double max_solver_time_in_seconds = 0.05;      // s, > 0: solver time limit per solve
   // Soft prior on each frame's motion relative to the previous window frame, when addFrame() is
-  // given a predicted motion (e.g. constant velocity). 0 disables it.
+  // given a predicted motion (e.g. constant velocity). A std of 0 leaves that part free.
   double motion_prior_sigma_rot_deg = 0.0;  // deg, >= 0: std of the rotation deviation
   double motion_prior_sigma_trans_m = 0.0;  // m, >= 0: std of the translation deviation
+  // The translation part in terms of the vehicle's acceleration (issue 15; docs/motion_prior.md):
+  // a frame's translation differs from the prediction's by (v_k - v_k-1) dt = a dt^2, so its std
+  // is sigma_a dt^2, dt from the frame times (no term when dt <= 0). Exclusive with
+  // motion_prior_sigma_trans_m; the rotation stays free unless motion_prior_sigma_rot_deg > 0. A
+  // car's acceleration rarely exceeds 1 g, and a weakly tracked frame, whose tracks leave its yaw
+  // and sideways step trading against each other, is held to the last step; it does not hold the
+  // rotation to the last rotation, whose error a rotation prior would repeat frame after frame.
+  double motion_prior_sigma_accel_m_s2 = 7.0;  // m/s^2, [0, 1000]: 0 = off
   // Zero-mean prior on each window frame's rotation relative to the previous window frame
   // (issue 15; RotationRatePriorResidual) along the pitch-like and roll-like directions
   // orthogonal to the vehicle's yaw axis: std = rate std x dt, dt from the frame times (no prior
@@ -116,6 +124,7 @@ struct WindowOptions {
     v("max_solver_time_in_seconds", s.max_solver_time_in_seconds);
     v("motion_prior_sigma_rot_deg", s.motion_prior_sigma_rot_deg);
     v("motion_prior_sigma_trans_m", s.motion_prior_sigma_trans_m);
+    v("motion_prior_sigma_accel_m_s2", s.motion_prior_sigma_accel_m_s2);
     v("rotation_rate_prior", s.rotation_rate_prior);
     v("rate_prior_pitch_deg_s", s.rate_prior_pitch_deg_s);
     v("rate_prior_yaw_deg_s", s.rate_prior_yaw_deg_s);

@@ -56,9 +56,10 @@ CLI::Option* addEnumOption(CLI::App& app, const std::string& name, E& value,
 
 // The window's motion priors (backend::WindowOptions, docs/backend.md), the same in every program
 // that runs the back end: the constant-velocity prior's --prior-rot-deg and --prior-trans-m (per
-// frame; 0 and 0 = off), and the rotation-rate prior's --no-rate-prior,
-// --rate-prior-pitch/-yaw/-roll (deg/s), --rate-prior-adapt-frames, --yaw-axis-memory-s,
-// --yaw-axis-prior-deg. A template so that this library needs nothing of the back end.
+// frame; 0 = that part off) or --prior-accel (the translation's std as an acceleration, m/s^2),
+// and the rotation-rate prior's --no-rate-prior, --rate-prior-pitch/-yaw/-roll (deg/s),
+// --rate-prior-adapt-frames, --yaw-axis-memory-s, --yaw-axis-prior-deg. A template so that this
+// library needs nothing of the back end.
 template <class WindowOptions>
 void addWindowPriorOptions(CLI::App& app, WindowOptions& win) {
   app.add_option("--prior-rot-deg", win.motion_prior_sigma_rot_deg,
@@ -67,7 +68,11 @@ void addWindowPriorOptions(CLI::App& app, WindowOptions& win) {
       ->check(CLI::Range(0.0, 180.0));
   app.add_option("--prior-trans-m", win.motion_prior_sigma_trans_m,
                  "constant-velocity prior: std of a frame's translation about the last motion's, m "
-                 "(window.motion_prior_sigma_trans_m)")
+                 "(window.motion_prior_sigma_trans_m; needs --prior-accel 0)")
+      ->check(CLI::Range(0.0, 1000.0));
+  app.add_option("--prior-accel", win.motion_prior_sigma_accel_m_s2,
+                 "constant-velocity prior on the translation as an acceleration std, m/s^2: the "
+                 "std is this x dt^2 (window.motion_prior_sigma_accel_m_s2; 0 = off)")
       ->check(CLI::Range(0.0, 1000.0));
   app.add_flag(
       "!--no-rate-prior", win.rotation_rate_prior,
