@@ -201,8 +201,9 @@ struct DirectionResidual {
 };
 
 // Two noise-free frames; returns the window after one solve with the given hook/prior settings.
+// same_time: frame 1 carries frame 0's time stamp (no frame interval).
 void twoFrames(BundleWindow& w, const WindowOptions& wo, const Isometry3& T_1_0,
-               const Isometry3* prior) {
+               const Isometry3* prior, bool same_time = false) {
   const auto cam = kittiCamera();
   testing::SceneOptions so;
   so.pixel_noise_px = 0.0;
@@ -214,7 +215,16 @@ void twoFrames(BundleWindow& w, const WindowOptions& wo, const Isometry3& T_1_0,
   const auto f0 = testing::observe(cam, pts, Isometry3::Identity(), 0, so);
   const auto f1 = testing::observe(cam, pts, T_1_0, 1, so);
   ASSERT_TRUE(w.addFrame(0, f0.time_ns, toWindow(f0), Isometry3::Identity()).isOk());
-  ASSERT_TRUE(w.addFrame(1, f1.time_ns, toWindow(f1), T_1_0, prior).isOk());
+  ASSERT_TRUE(
+      w.addFrame(1, same_time ? f0.time_ns : f1.time_ns, toWindow(f1), T_1_0, prior).isOk());
+}
+
+// A motion prior's prediction off the true T_1_0: turned by 0.5 deg about y, moved by dt_m.
+Isometry3 offPrediction(const Isometry3& T_1_0, const Eigen::Vector3d& dt_m) {
+  Isometry3 predicted = T_1_0;
+  predicted.linear() = expSO3(Eigen::Vector3d(0.0, 0.5 * M_PI / 180.0, 0.0)) * predicted.linear();
+  predicted.translation() += dt_m;
+  return predicted;
 }
 
 TEST(BundleWindow, PoseResidualHookAddsResidualsThatShapeTheSolution) {
@@ -259,9 +269,7 @@ TEST(BundleWindow, PoseResidualHookAddsResidualsThatShapeTheSolution) {
 
 TEST(BundleWindow, MotionPriorPullsTowardThePrediction) {
   const Isometry3 T_1_0 = testing::forwardMotion(1.0, 1.0);
-  Isometry3 predicted = T_1_0;
-  predicted.linear() = expSO3(Eigen::Vector3d(0.0, 0.5 * M_PI / 180.0, 0.0)) * predicted.linear();
-  predicted.translation() += Eigen::Vector3d(0.0, 0.0, 0.2);
+  const Isometry3 predicted = offPrediction(T_1_0, Eigen::Vector3d(0.0, 0.0, 0.2));
   WindowOptions wo;
   wo.max_num_iterations = 50;
   wo.max_solver_time_in_seconds = 10.0;  // bounded by iterations (slow under qemu-aarch64)
@@ -298,9 +306,7 @@ TEST(BundleWindow, MotionPriorPullsTowardThePrediction) {
 // the rotation to the data; without a frame interval (dt <= 0) it adds nothing.
 TEST(BundleWindow, AccelerationPriorHoldsTheTranslationAndLeavesTheRotation) {
   const Isometry3 T_1_0 = testing::forwardMotion(1.0, 1.0);
-  Isometry3 predicted = T_1_0;
-  predicted.linear() = expSO3(Eigen::Vector3d(0.0, 0.5 * M_PI / 180.0, 0.0)) * predicted.linear();
-  predicted.translation() += Eigen::Vector3d(0.1, 0.0, 0.2);
+  const Isometry3 predicted = offPrediction(T_1_0, Eigen::Vector3d(0.1, 0.0, 0.2));
   WindowOptions wo;
   wo.max_num_iterations = 50;
   wo.max_solver_time_in_seconds = 10.0;
@@ -317,17 +323,8 @@ TEST(BundleWindow, AccelerationPriorHoldsTheTranslationAndLeavesTheRotation) {
   EXPECT_GT(testing::rotationErrorDeg(w.T_k_b(1), predicted), 0.2);
 
   // Two frames with the same time: no interval, no prior.
-  const auto cam = kittiCamera();
-  testing::SceneOptions so;
-  so.pixel_noise_px = 0.0;
-  const auto pts = testing::makeLandmarks(so, 2.0);
   BundleWindow same;
-  ASSERT_TRUE(same.init(wo, cam).isOk());
-  same.reset(Isometry3::Identity());
-  const auto f0 = testing::observe(cam, pts, Isometry3::Identity(), 0, so);
-  const auto f1 = testing::observe(cam, pts, T_1_0, 1, so);
-  ASSERT_TRUE(same.addFrame(0, f0.time_ns, toWindow(f0), Isometry3::Identity()).isOk());
-  ASSERT_TRUE(same.addFrame(1, f0.time_ns, toWindow(f1), T_1_0, &predicted).isOk());
+  twoFrames(same, wo, T_1_0, &predicted, /*same_time=*/true);
   auto s2 = same.solve();
   ASSERT_TRUE(s2);
   EXPECT_EQ(s2->num_prior_residuals, 0);
