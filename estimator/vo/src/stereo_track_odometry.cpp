@@ -19,6 +19,8 @@ Isometry3 rigid(Isometry3 T) {
   return T;
 }
 
+constexpr double kMaxPredictionRatio = 10.0;  // intervals, see predictMotion
+
 double msSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -38,6 +40,35 @@ std::uint64_t mixSeed(std::uint64_t x) {
 double StereoTrackOdometry::frameGap(const FrameFeatures& frame, const RefFrame& ref) {
   const auto d = static_cast<std::int64_t>(frame.sequence - ref.sequence);
   return d < 1 ? 1.0 : static_cast<double>(d);
+}
+
+// Constant velocity in time, not per frame: a camera that drops a frame, or whose interval
+// jitters, still gets the motion it made. KITTI raw and odometry data number their frames
+// consecutively across a dropped one while the timestamp jumps, so the sequence alone does not
+// show the gap. Measured on 0020's tracks with 10-25 % of the frames dropped
+// (docs/motion_prior.md): the per-frame prediction held a two-interval step to a one-interval one,
+// and with the step prior the mean segment error was 15.2 % against 6.3 % without it (4.1 %
+// scaled). Where the times do not increase the frame counts give the ratio. The rotation's angle
+// and the translation scale alike (exact to first order in the rotation). Constant velocity is
+// not believed over more than kMaxPredictionRatio intervals (a paused recording): a lost frame's
+// pose is predicted no further, and the step prior's std (sigma_a dt^2) is by then metres.
+Isometry3 StereoTrackOdometry::predictMotion(const FrameFeatures& frame,
+                                             std::uint64_t from_sequence,
+                                             TimeNs from_time_ns) const {
+  const TimeNs dt_ns = frame.time_ns - from_time_ns;
+  double ratio = 1.0;
+  if (dt_ns > 0 && last_motion_dt_ns_ > 0) {
+    ratio = static_cast<double>(dt_ns) / static_cast<double>(last_motion_dt_ns_);
+  } else {
+    const auto d = static_cast<std::int64_t>(frame.sequence - from_sequence);
+    ratio = (d < 1 ? 1.0 : static_cast<double>(d)) / last_motion_gap_;
+  }
+  ratio = std::min(ratio, kMaxPredictionRatio);
+  if (ratio == 1.0) return last_motion_;
+  Isometry3 T = Isometry3::Identity();
+  T.linear() = expSO3(ratio * logSO3(last_motion_.linear()));
+  T.translation() = ratio * last_motion_.translation();
+  return T;
 }
 
 const char* toString(TrackingStatus s) {
@@ -92,6 +123,8 @@ Status StereoTrackOdometry::init(const VoOptions& options, const StereoCamera& c
   T_w_c0_ = T_w_c0;
   T_w_last_ = T_w_c0;
   last_motion_ = Isometry3::Identity();
+  last_motion_dt_ns_ = 0;
+  last_motion_gap_ = 1.0;
   have_motion_ = false;
   lost_ = false;
   initialized_ = true;
@@ -180,6 +213,8 @@ Expected<VoResult> StereoTrackOdometry::process(const FrameFeatures& frame) {
     r.T_w_c = T_w_c0_;
     r.status = TrackingStatus::kInitializing;
     T_w_last_ = T_w_c0_;
+    last_sequence_ = frame.sequence;
+    last_time_ns_ = frame.time_ns;
     store(good_, frame, T_w_c0_);
     SUNVO_RETURN_IF_ERROR(restartWindowAt(good_));
     return r;
@@ -207,12 +242,15 @@ Expected<VoResult> StereoTrackOdometry::process(const FrameFeatures& frame) {
 
   if (ref == nullptr) {
     // Lost: predict, remember this frame as the most recent lost one, keep good_ and the window.
-    const Isometry3 motion =
-        options_.constant_velocity_on_loss ? last_motion_ : Isometry3::Identity();
+    const Isometry3 motion = options_.constant_velocity_on_loss
+                                 ? rigid(predictMotion(frame, last_sequence_, last_time_ns_))
+                                 : Isometry3::Identity();
     r.T_k_km1 = motion;
     r.T_w_c = rigid(T_w_last_ * motion.inverse());
     r.status = TrackingStatus::kLost;
     T_w_last_ = r.T_w_c;
+    last_sequence_ = frame.sequence;
+    last_time_ns_ = frame.time_ns;
     store(lost_frame_, frame, r.T_w_c);
     lost_ = true;
     return r;
@@ -241,11 +279,16 @@ Expected<VoResult> StereoTrackOdometry::process(const FrameFeatures& frame) {
       window_obs_[static_cast<std::size_t>(n++)] = {o.landmark_id,
                                                     {o.u_left, o.v_left, o.disparity()}};
     }
-    // Constant-velocity prior: only between consecutive, well-tracked frames.
-    const bool use_prior = ref == &good_ && r.reference_gap == 1 && have_motion_;
+    // Constant-velocity prior from the last well-tracked frame (the window's newest). Its
+    // acceleration form scales with the interval and so bridges a lost or dropped frame; the
+    // per-frame form only joins consecutive frames.
+    const bool use_prior =
+        ref == &good_ && have_motion_ &&
+        (r.reference_gap == 1 || options_.window.motion_prior_sigma_accel_m_s2 > 0.0);
+    const Isometry3 predicted = rigid(predictMotion(frame, good_.sequence, good_.time_ns));
     SUNVO_RETURN_IF_ERROR(window_.addFrame(
         frame.sequence, frame.time_ns, std::span(window_obs_.data(), static_cast<std::size_t>(n)),
-        est.T_k_km1, use_prior ? &last_motion_ : nullptr));
+        est.T_k_km1, use_prior ? &predicted : nullptr));
     auto sol = window_.solve();
     if (sol) {
       const Isometry3 T_w_new = window_.T_w_newest();
@@ -272,13 +315,15 @@ Expected<VoResult> StereoTrackOdometry::process(const FrameFeatures& frame) {
   r.T_k_km1 = T_w_k.inverse() * T_w_last_;
   r.T_w_c = T_w_k;
   r.status = lost_ ? TrackingStatus::kRecovered : TrackingStatus::kTracking;
-  if (r.reference_gap == 1) {
-    last_motion_ = rigid(T_w_k.inverse() * ref->T_w_c);
-    have_motion_ = true;
-  }
+  last_motion_ = rigid(T_w_k.inverse() * ref->T_w_c);
+  last_motion_dt_ns_ = frame.time_ns > ref->time_ns ? frame.time_ns - ref->time_ns : 0;
+  last_motion_gap_ = static_cast<double>(r.reference_gap);
+  have_motion_ = true;
   lost_ = false;
   lost_frame_.valid = false;
   T_w_last_ = T_w_k;
+  last_sequence_ = frame.sequence;
+  last_time_ns_ = frame.time_ns;
   store(good_, frame, T_w_k);
   return r;
 }

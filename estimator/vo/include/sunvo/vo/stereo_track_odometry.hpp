@@ -9,12 +9,13 @@
 //
 // Degenerate input (no or too few matches, all points at infinity / zero disparity, too few
 // inliers, a non-finite or implausible result) never yields NaN: the frame is reported kLost, its
-// pose is predicted with the last good inter-frame motion (constant velocity, or identity when
-// VoOptions::constant_velocity_on_loss is false). The next frame is matched first with the last
-// well-tracked frame (the lost frame's pose was only a prediction, and real tracks persist across
-// a bad frame), then with the lost frame (the window then restarts there); the first frame that
-// tracks again is reported kRecovered. Zero motion between two good frames is not degenerate for a
-// stereo camera (depth is measured): it is tracked and gives T_k_km1 = identity.
+// pose is predicted with the last good inter-frame motion scaled to this frame's interval
+// (constant velocity in time, or identity when VoOptions::constant_velocity_on_loss is false). The
+// next frame is matched first with the last well-tracked frame (the lost frame's pose was only a
+// prediction, and real tracks persist across a bad frame), then with the lost frame (the window
+// then restarts there); the first frame that tracks again is reported kRecovered. Zero motion
+// between two good frames is not degenerate for a stereo camera (depth is measured): it is tracked
+// and gives T_k_km1 = identity.
 
 #include <cstdint>
 #include <span>
@@ -103,6 +104,10 @@ class StereoTrackOdometry {
   };
   void store(RefFrame& ref, const FrameFeatures& frame, const Isometry3& T_w_c);
   static double frameGap(const FrameFeatures& frame, const RefFrame& ref);
+  // The constant-velocity prediction of the motion T_k_from from a frame seen at (sequence,
+  // time_ns) to `frame`: the last measured motion scaled by the ratio of the two intervals.
+  Isometry3 predictMotion(const FrameFeatures& frame, std::uint64_t from_sequence,
+                          TimeNs from_time_ns) const;
   int associate(const RefFrame& ref, const FrameFeatures& frame);
   int baseObservations(const RefFrame& ref);
   Status restartWindowAt(const RefFrame& ref);
@@ -115,8 +120,15 @@ class StereoTrackOdometry {
   bool lost_ = false;
   bool have_motion_ = false;  // last_motion_ was measured (not the initial identity)
   Isometry3 T_w_c0_ = Isometry3::Identity();
-  Isometry3 T_w_last_ = Isometry3::Identity();     // pose emitted for the previous frame
-  Isometry3 last_motion_ = Isometry3::Identity();  // T_k_km1 of the last good consecutive pair
+  Isometry3 T_w_last_ = Isometry3::Identity();  // pose emitted for the previous frame
+  // The last measured motion T_k_ref between two tracked frames, and the interval it spans: its
+  // time (ns, 0 = unknown: the frames' times did not increase) and its frame count (>= 1).
+  Isometry3 last_motion_ = Isometry3::Identity();
+  TimeNs last_motion_dt_ns_ = 0;
+  double last_motion_gap_ = 1.0;
+  // The previous frame (tracked or lost), where a lost frame's prediction starts from.
+  std::uint64_t last_sequence_ = 0;
+  TimeNs last_time_ns_ = 0;
   // The last well-tracked frame (the window's newest frame) and the most recent lost frame.
   // After a loss the next frame is matched with `good_` first (bridging the lost frame, whose
   // pose was only predicted), then with `lost_frame_`.
