@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <tuple>
 
 namespace sunvo::backend {
 
@@ -36,6 +37,15 @@ Status WindowOptions::validate() const {
   }
   if (!(motion_prior_sigma_accel_m_s2 >= 0.0 && motion_prior_sigma_accel_m_s2 <= 1000.0)) {
     return invalidArgument("window.motion_prior_sigma_accel_m_s2 must be in [0, 1000]");
+  }
+  for (const auto& [key, value, lo, hi, range] :
+       {std::tuple{"lateral_prior_sigma_m_s", lateral_prior_sigma_m_s, 0.0, 100.0, "[0, 100]"},
+        std::tuple{"lateral_lever_m", lateral_lever_m, -10.0, 10.0, "[-10, 10]"},
+        std::tuple{"lateral_lever_sigma_m", lateral_lever_sigma_m, 0.0, 10.0, "[0, 10]"},
+        std::tuple{"lateral_mount_sigma_deg", lateral_mount_sigma_deg, 0.0, 45.0, "[0, 45]"}}) {
+    if (!(value >= lo && value <= hi)) {
+      return invalidArgument(std::string("window.") + key + " must be in " + range);
+    }
   }
   if (motion_prior_sigma_trans_m > 0.0 && motion_prior_sigma_accel_m_s2 > 0.0) {
     return invalidArgument(
@@ -223,26 +233,44 @@ Status BundleWindow::addFrame(std::uint64_t sequence, TimeNs time_ns,
   std::copy(obs.begin(), obs.end(), f.obs.begin());
   f.num_obs = static_cast<int>(obs.size());
   // The translation std: per frame, or from the acceleration std over this frame's interval.
+  const double dt = slot > 0
+                        ? 1e-9 * static_cast<double>(
+                                     time_ns - frames_[static_cast<std::size_t>(slot - 1)].time_ns)
+                        : 0.0;
   double s_trans = options_.motion_prior_sigma_trans_m;
   if (slot > 0 && options_.motion_prior_sigma_accel_m_s2 > 0.0) {
-    const double dt =
-        1e-9 * static_cast<double>(time_ns - frames_[static_cast<std::size_t>(slot - 1)].time_ns);
     s_trans = dt > 0.0 ? options_.motion_prior_sigma_accel_m_s2 * dt * dt : 0.0;
   }
-  f.has_prior = slot > 0 && motion_prior != nullptr &&
-                (options_.motion_prior_sigma_rot_deg > 0.0 || s_trans > 0.0) &&
-                allFinite(*motion_prior);
-  if (f.has_prior) {
+  const bool predicted = slot > 0 && motion_prior != nullptr &&
+                         (options_.motion_prior_sigma_rot_deg > 0.0 || s_trans > 0.0) &&
+                         allFinite(*motion_prior);
+  // The sideways row's std: the vehicle's own sideways velocity over dt, widened by what the
+  // model's two parameters leave open for this step (t_z and psi of the initial guess).
+  const double psi_guess = logSO3(T_k_km1_guess.linear()).y();
+  const double s_lat =
+      std::hypot(options_.lateral_prior_sigma_m_s * dt,
+                 options_.lateral_mount_sigma_deg * M_PI / 180.0 * T_k_km1_guess.translation().z(),
+                 options_.lateral_lever_sigma_m * psi_guess);
+  const bool lateral =
+      slot > 0 && options_.lateral_prior_sigma_m_s > 0.0 && dt > 0.0 && std::isfinite(s_lat);
+  f.has_prior = predicted || lateral;
+  f.prior = MotionPriorData{};
+  if (predicted) {
     const Eigen::Quaterniond q(motion_prior->linear());
     f.prior.q_pred[0] = q.x();
     f.prior.q_pred[1] = q.y();
     f.prior.q_pred[2] = q.z();
     f.prior.q_pred[3] = q.w();
     for (int i = 0; i < 3; ++i) f.prior.t_pred[i] = motion_prior->translation()[i];
-    // A std of 0 leaves that part of the motion free (its rows weigh nothing).
-    const double s_rot = options_.motion_prior_sigma_rot_deg * M_PI / 180.0;
-    f.prior.sqrt_info_rot = s_rot > 0.0 ? 1.0 / s_rot : 0.0;
-    f.prior.sqrt_info_trans = s_trans > 0.0 ? 1.0 / s_trans : 0.0;
+  }
+  // A std of 0 leaves that part of the motion free (its rows weigh nothing).
+  const double s_rot = options_.motion_prior_sigma_rot_deg * M_PI / 180.0;
+  f.prior.sqrt_info_rot = predicted && s_rot > 0.0 ? 1.0 / s_rot : 0.0;
+  f.prior.sqrt_info_trans = predicted && s_trans > 0.0 ? 1.0 / s_trans : 0.0;
+  if (lateral) {
+    f.prior.lateral_beta = 0.0;
+    f.prior.lateral_lever_m = options_.lateral_lever_m;
+    f.prior.sqrt_info_lateral = 1.0 / s_lat;
   }
   if (slot == 0) {
     poses_[0] = PoseBlock{};

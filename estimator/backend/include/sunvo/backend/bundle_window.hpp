@@ -80,6 +80,18 @@ struct WindowOptions {
   // and sideways step trading against each other, is held to the last step; it does not hold the
   // rotation to the last rotation, whose error a rotation prior would repeat frame after frame.
   double motion_prior_sigma_accel_m_s2 = 7.0;  // m/s^2, [0, 1000]: 0 = off
+  // Non-holonomic prior (docs/lateral_prior.md; MotionPriorResidual's last row): a wheeled
+  // vehicle that does not skid steps sideways only as much as its own turn and the camera's lever
+  // arm ahead of the rear axle imply. Each frame's sideways step is held to that with std
+  //   hypot(lateral_prior_sigma_m_s dt, |t_z| mount_sigma, |psi| lateral_lever_sigma_m)
+  // (t_z, psi: the frame's initial guess): the vehicle's own sideways velocity, a camera whose
+  // axis is aligned with the vehicle's to within lateral_mount_sigma_deg, and a lever arm known to
+  // within its std. The lever arm is the vehicle's geometry, measured on it like any extrinsic.
+  // Off for a vehicle that moves sideways (crab or skid steering, a legged robot).
+  double lateral_prior_sigma_m_s = 0.0;  // m/s, [0, 100]: 0 = off
+  double lateral_lever_m = 0.0;          // m, [-10, 10]: the camera ahead of the rear axle
+  double lateral_lever_sigma_m = 0.1;    // m, [0, 10]: the lever arm's std
+  double lateral_mount_sigma_deg = 2.0;  // deg, [0, 45]: the camera axis against the vehicle's
   // Zero-mean prior on each window frame's rotation relative to the previous window frame
   // (issue 15; RotationRatePriorResidual) along the pitch-like and roll-like directions
   // orthogonal to the vehicle's yaw axis: std = rate std x dt, dt from the frame times (no prior
@@ -125,6 +137,10 @@ struct WindowOptions {
     v("motion_prior_sigma_rot_deg", s.motion_prior_sigma_rot_deg);
     v("motion_prior_sigma_trans_m", s.motion_prior_sigma_trans_m);
     v("motion_prior_sigma_accel_m_s2", s.motion_prior_sigma_accel_m_s2);
+    v("lateral_prior_sigma_m_s", s.lateral_prior_sigma_m_s);
+    v("lateral_lever_m", s.lateral_lever_m);
+    v("lateral_lever_sigma_m", s.lateral_lever_sigma_m);
+    v("lateral_mount_sigma_deg", s.lateral_mount_sigma_deg);
     v("rotation_rate_prior", s.rotation_rate_prior);
     v("rate_prior_pitch_deg_s", s.rate_prior_pitch_deg_s);
     v("rate_prior_yaw_deg_s", s.rate_prior_yaw_deg_s);

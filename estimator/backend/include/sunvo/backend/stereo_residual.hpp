@@ -85,13 +85,28 @@ struct MotionPriorData {
   double t_pred[3] = {0.0, 0.0, 0.0};       // t_k_km1 predicted, m
   double sqrt_info_rot = 1.0;               // 1/rad
   double sqrt_info_trans = 1.0;             // 1/m
+  // The non-holonomic row (below): the direction of travel seen by the camera (x slope), the
+  // camera's lever arm ahead of the rear axle, and the row's weight (0 = no row).
+  double lateral_beta = 0.0;       // rad
+  double lateral_lever_m = 0.0;    // m
+  double sqrt_info_lateral = 0.0;  // 1/m
 };
 
 // Soft prior on the relative motion of slots km1 and k (both expressed in the base b):
 //   T_k_km1 = T_k_b T_km1_b^-1:  C = C_k_b C_km1_b^T,  t = t_k_b - C t_km1_b.
 // Rotation error: dq = q_pred^-1 * q(C); for a small error dq = (sin(a/2) n, cos(a/2)) so
 // 2 vec(dq) = a n, the rotation vector (sign chosen so that dq.w >= 0). Translation error
-// t - t_pred. Residual r = (2 vec(dq) / sigma_rot, (t - t_pred) / sigma_trans).
+// t - t_pred. Residual r = (2 vec(dq) / sigma_rot, (t - t_pred) / sigma_trans, r_lat) with the
+// non-holonomic row of a wheeled vehicle that does not skid (docs/lateral_prior.md):
+//   psi = 2 vec(q(C)).y (the yaw part of the relative rotation, sign as above),
+//   r_lat = (t_x - beta t_z - psi (t_z / 2 + L)) / sigma_lat.
+// Derivation, first order in psi: the rear axle has no sideways velocity, so over the frame it
+// moves along an arc of length s turning by psi, whose chord leaves at psi/2 to the old heading.
+// A camera L ahead of the axle then moves in frame k-1 by d = (s psi/2 + L psi, 0, s) (x towards
+// the turn). t = -C d and C turns x by -psi z, so t_x = -(s psi/2 + L psi) + psi s =
+// s psi/2 - L psi; with s = -t_z and psi's sign taken from C, t_x = psi (t_z/2 + L). A camera that
+// sees the direction of travel at (beta, 0, 1) adds -beta s = beta t_z.
+// It holds the sideways step to what the step's own yaw and length imply, not to the last step's.
 class MotionPriorResidual {
  public:
   explicit MotionPriorResidual(const MotionPriorData* prior) : prior_(prior) {}
@@ -116,11 +131,15 @@ class MotionPriorResidual {
     for (int i = 0; i < 3; ++i) {
       residual[3 + i] = T(prior_->sqrt_info_trans) * (t_rel[i] - T(prior_->t_pred[i]));
     }
+    const T psi = (q_rel.w() < T(0.0) ? T(-2.0) : T(2.0)) * q_rel.y();
+    residual[6] =
+        T(prior_->sqrt_info_lateral) * (t_rel[0] - T(prior_->lateral_beta) * t_rel[2] -
+                                        psi * (T(0.5) * t_rel[2] + T(prior_->lateral_lever_m)));
     return true;
   }
 
   static ceres::CostFunction* Create(const MotionPriorData* prior) {
-    return new ceres::AutoDiffCostFunction<MotionPriorResidual, 6, 4, 3, 4, 3>(
+    return new ceres::AutoDiffCostFunction<MotionPriorResidual, 7, 4, 3, 4, 3>(
         new MotionPriorResidual(prior));
   }
 

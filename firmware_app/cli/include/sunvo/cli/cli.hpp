@@ -74,6 +74,21 @@ void addWindowPriorOptions(CLI::App& app, WindowOptions& win) {
                  "constant-velocity prior on the translation as an acceleration std, m/s^2: the "
                  "std is this x dt^2 (window.motion_prior_sigma_accel_m_s2; 0 = off)")
       ->check(CLI::Range(0.0, 1000.0));
+  app.add_option("--lateral-prior", win.lateral_prior_sigma_m_s,
+                 "non-holonomic prior: std of the camera's sideways velocity about a wheeled "
+                 "vehicle's, m/s (window.lateral_prior_sigma_m_s; 0 = off)")
+      ->check(CLI::Range(0.0, 100.0));
+  app.add_option("--lever-m", win.lateral_lever_m,
+                 "non-holonomic prior: the camera's distance ahead of the rear axle, m "
+                 "(window.lateral_lever_m)")
+      ->check(CLI::Range(-10.0, 10.0));
+  app.add_option("--lever-sigma-m", win.lateral_lever_sigma_m,
+                 "non-holonomic prior: the std of --lever-m, m (window.lateral_lever_sigma_m)")
+      ->check(CLI::Range(0.0, 10.0));
+  app.add_option("--mount-sigma-deg", win.lateral_mount_sigma_deg,
+                 "non-holonomic prior: how well the camera axis is aligned with the vehicle's, deg "
+                 "(window.lateral_mount_sigma_deg)")
+      ->check(CLI::Range(0.0, 45.0));
   app.add_flag(
       "!--no-rate-prior", win.rotation_rate_prior,
       "VO without the window's zero-mean rotation-rate prior (window.rotation_rate_prior)");
