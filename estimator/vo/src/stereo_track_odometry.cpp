@@ -53,15 +53,13 @@ double StereoTrackOdometry::frameGap(const FrameFeatures& frame, const RefFrame&
 // not believed over more than kMaxPredictionRatio intervals (a paused recording): a lost frame's
 // pose is predicted no further, and the step prior's std (sigma_a dt^2) is by then metres.
 Isometry3 StereoTrackOdometry::predictMotion(const FrameFeatures& frame,
-                                             std::uint64_t from_sequence,
-                                             TimeNs from_time_ns) const {
-  const TimeNs dt_ns = frame.time_ns - from_time_ns;
+                                             const RefFrame& from) const {
+  const TimeNs dt_ns = frame.time_ns - from.time_ns;
   double ratio = 1.0;
   if (dt_ns > 0 && last_motion_dt_ns_ > 0) {
     ratio = static_cast<double>(dt_ns) / static_cast<double>(last_motion_dt_ns_);
   } else {
-    const auto d = static_cast<std::int64_t>(frame.sequence - from_sequence);
-    ratio = (d < 1 ? 1.0 : static_cast<double>(d)) / last_motion_gap_;
+    ratio = frameGap(frame, from) / last_motion_gap_;
   }
   ratio = std::min(ratio, kMaxPredictionRatio);
   if (ratio == 1.0) return last_motion_;
@@ -213,8 +211,6 @@ Expected<VoResult> StereoTrackOdometry::process(const FrameFeatures& frame) {
     r.T_w_c = T_w_c0_;
     r.status = TrackingStatus::kInitializing;
     T_w_last_ = T_w_c0_;
-    last_sequence_ = frame.sequence;
-    last_time_ns_ = frame.time_ns;
     store(good_, frame, T_w_c0_);
     SUNVO_RETURN_IF_ERROR(restartWindowAt(good_));
     return r;
@@ -243,14 +239,12 @@ Expected<VoResult> StereoTrackOdometry::process(const FrameFeatures& frame) {
   if (ref == nullptr) {
     // Lost: predict, remember this frame as the most recent lost one, keep good_ and the window.
     const Isometry3 motion = options_.constant_velocity_on_loss
-                                 ? rigid(predictMotion(frame, last_sequence_, last_time_ns_))
+                                 ? rigid(predictMotion(frame, lost_ ? lost_frame_ : good_))
                                  : Isometry3::Identity();
     r.T_k_km1 = motion;
     r.T_w_c = rigid(T_w_last_ * motion.inverse());
     r.status = TrackingStatus::kLost;
     T_w_last_ = r.T_w_c;
-    last_sequence_ = frame.sequence;
-    last_time_ns_ = frame.time_ns;
     store(lost_frame_, frame, r.T_w_c);
     lost_ = true;
     return r;
@@ -285,7 +279,7 @@ Expected<VoResult> StereoTrackOdometry::process(const FrameFeatures& frame) {
     const bool use_prior =
         ref == &good_ && have_motion_ &&
         (r.reference_gap == 1 || options_.window.motion_prior_sigma_accel_m_s2 > 0.0);
-    const Isometry3 predicted = rigid(predictMotion(frame, good_.sequence, good_.time_ns));
+    const Isometry3 predicted = rigid(predictMotion(frame, good_));
     SUNVO_RETURN_IF_ERROR(window_.addFrame(
         frame.sequence, frame.time_ns, std::span(window_obs_.data(), static_cast<std::size_t>(n)),
         est.T_k_km1, use_prior ? &predicted : nullptr));
@@ -322,8 +316,6 @@ Expected<VoResult> StereoTrackOdometry::process(const FrameFeatures& frame) {
   lost_ = false;
   lost_frame_.valid = false;
   T_w_last_ = T_w_k;
-  last_sequence_ = frame.sequence;
-  last_time_ns_ = frame.time_ns;
   store(good_, frame, T_w_k);
   return r;
 }

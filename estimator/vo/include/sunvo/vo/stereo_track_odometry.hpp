@@ -104,10 +104,9 @@ class StereoTrackOdometry {
   };
   void store(RefFrame& ref, const FrameFeatures& frame, const Isometry3& T_w_c);
   static double frameGap(const FrameFeatures& frame, const RefFrame& ref);
-  // The constant-velocity prediction of the motion T_k_from from a frame seen at (sequence,
-  // time_ns) to `frame`: the last measured motion scaled by the ratio of the two intervals.
-  Isometry3 predictMotion(const FrameFeatures& frame, std::uint64_t from_sequence,
-                          TimeNs from_time_ns) const;
+  // The constant-velocity prediction of the motion T_k_from from the reference `from` to `frame`:
+  // the last measured motion scaled by the ratio of the two intervals.
+  Isometry3 predictMotion(const FrameFeatures& frame, const RefFrame& from) const;
   int associate(const RefFrame& ref, const FrameFeatures& frame);
   int baseObservations(const RefFrame& ref);
   Status restartWindowAt(const RefFrame& ref);
@@ -126,10 +125,8 @@ class StereoTrackOdometry {
   Isometry3 last_motion_ = Isometry3::Identity();
   TimeNs last_motion_dt_ns_ = 0;
   double last_motion_gap_ = 1.0;
-  // The previous frame (tracked or lost), where a lost frame's prediction starts from.
-  std::uint64_t last_sequence_ = 0;
-  TimeNs last_time_ns_ = 0;
-  // The last well-tracked frame (the window's newest frame) and the most recent lost frame.
+  // The last well-tracked frame (the window's newest frame) and the most recent lost frame; the
+  // previous frame is lost_frame_ while lost_, else good_.
   // After a loss the next frame is matched with `good_` first (bridging the lost frame, whose
   // pose was only predicted), then with `lost_frame_`.
   RefFrame good_;
