@@ -11,51 +11,46 @@
 // the last N frames (the std of a zero-mean Gaussian; a few frames where the window's own roll is
 // wrong, as on the one-sided frames of the real tracks, do not move a median).
 //
-// Fixed memory (a ring of kMaxFrames per axis, a scratch copy for the median), no allocation, no
-// threads. undoLastPush() takes back the newest sample (the window's restoreInitialGuess()).
+// Fixed memory (SampleRing), no allocation, no threads. undoLastPush() takes back the newest
+// sample (the window's restoreInitialGuess()).
 
 #include <Eigen/Core>
 #include <algorithm>
-#include <array>
-#include <cstddef>
+#include <cmath>
+
+#include "sunvo/backend/sample_ring.hpp"
 
 namespace sunvo::backend {
 
-class RateSpread {
+inline constexpr int kRateSpreadMaxFrames = 256;
+
+class RateSpread : private SampleRing<3, kRateSpreadMaxFrames> {
+  using Ring = SampleRing<3, kRateSpreadMaxFrames>;
+
  public:
-  static constexpr int kMaxFrames = 256;
+  static constexpr int kMaxFrames = kRateSpreadMaxFrames;
   // Fewer samples than this give no spread (the configured std alone holds).
   static constexpr int kMinSamples = 10;
 
-  // frames: samples kept per axis, [0, kMaxFrames]; 0 keeps nothing (spread() is always 0).
+  // frames: samples kept per axis, [0, kMaxFrames] (setCapacity clamps and clears); 0 keeps
+  // nothing (spread() is always 0).
   explicit RateSpread(int frames = 0) { setCapacity(frames); }
-  void setCapacity(int frames);  // clamps to [0, kMaxFrames] and clears
-  void clear();
+  using Ring::capacity, Ring::clear, Ring::commit, Ring::setCapacity, Ring::size,
+      Ring::undoLastPush;
 
   // rate: the newest frame's rotation rate along the basis rows, rad/s. A non-finite sample is
   // ignored (returns false).
-  bool push(const Eigen::Vector3d& rate_rad_s);
-  // Takes back the newest push() made since the last commit(); false when there is none.
-  bool undoLastPush();
-  // Makes the samples pushed so far final (undoLastPush() no longer takes them back).
-  void commit() { can_undo_ = false; }
-
+  bool push(const Eigen::Vector3d& rate_rad_s) {
+    return Ring::push(
+        {std::abs(rate_rad_s.x()), std::abs(rate_rad_s.y()), std::abs(rate_rad_s.z())});
+  }
   // Whether enough samples are kept for spread(): at least min(kMinSamples, capacity), and any.
-  bool ready() const { return size_ > 0 && size_ >= std::min(kMinSamples, capacity_); }
+  bool ready() const { return size() > 0 && size() >= std::min(kMinSamples, capacity()); }
   // 1.4826 x median |rate| per axis over the kept samples, rad/s; 0 while not ready().
-  Eigen::Vector3d spread() const;
-  int size() const { return size_; }
-  int capacity() const { return capacity_; }
-
- private:
-  std::array<std::array<double, kMaxFrames>, 3> ring_{};  // |rate| per axis
-  std::array<double, 3> overwritten_{};                   // the samples the newest push() replaced
-  bool overwrote_ = false;                                // whether it replaced samples (ring full)
-  bool can_undo_ = false;
-  int capacity_ = 0;
-  int head_ = 0;  // next slot to write
-  int size_ = 0;
-  mutable std::array<double, kMaxFrames> scratch_{};
+  Eigen::Vector3d spread() const {
+    if (!ready()) return Eigen::Vector3d::Zero();
+    return 1.4826 * Eigen::Vector3d(median(0), median(1), median(2));
+  }
 };
 
 }  // namespace sunvo::backend
