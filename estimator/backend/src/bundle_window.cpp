@@ -55,6 +55,10 @@ Status WindowOptions::validate() const {
         "window.motion_prior_sigma_trans_m and window.motion_prior_sigma_accel_m_s2 are two forms "
         "of one std: set one of them to 0");
   }
+  if (lateral_beta_frames < 0 || lateral_beta_frames > TravelDirection::kMaxFrames) {
+    return invalidArgument("window.lateral_beta_frames must be in [0, " +
+                           std::to_string(TravelDirection::kMaxFrames) + "]");
+  }
   if (rate_prior_adapt_frames < 0 || rate_prior_adapt_frames > RateSpread::kMaxFrames) {
     return invalidArgument("window.rate_prior_adapt_frames must be in [0, " +
                            std::to_string(RateSpread::kMaxFrames) + "]");
@@ -113,6 +117,7 @@ Status BundleWindow::init(const WindowOptions& options, const StereoCamera& came
   saved_yaw_scatter_ = yaw_scatter_;
   saved_yaw_axis_c_ = yaw_axis_c_;
   rate_spread_.setCapacity(options.rate_prior_adapt_frames);
+  travel_.setCapacity(options.lateral_prior_sigma_m_s > 0.0 ? options.lateral_beta_frames : 0);
   num_residuals_ = 0;
 
   switch (options.loss) {
@@ -264,7 +269,8 @@ Status BundleWindow::addFrame(std::uint64_t sequence, TimeNs time_ns,
   const double s_rot = options_.motion_prior_sigma_rot_deg * M_PI / 180.0;
   f.prior.sqrt_info_rot = predicted && s_rot > 0.0 ? 1.0 / s_rot : 0.0;
   f.prior.sqrt_info_trans = predicted && s_trans > 0.0 ? 1.0 / s_trans : 0.0;
-  if (lateral) {  // beta stays 0: the mount's turn is in s_lat
+  if (lateral) {  // beta is 0 until learnt; the mount's turn is in s_lat either way
+    f.prior.lateral_beta = travel_.beta();
     f.prior.lateral_lever_m = options_.lateral_lever_m;
     f.prior.sqrt_info_lateral = 1.0 / s_lat;
   }
@@ -471,6 +477,7 @@ Expected<WindowSolveSummary> BundleWindow::solve() {
   saved_yaw_scatter_ = yaw_scatter_;
   saved_yaw_axis_c_ = yaw_axis_c_;
   rate_spread_.commit();
+  travel_.commit();
   if (hook_) {
     in_hook_ = true;
     const Status s = hook_(*this);
@@ -502,6 +509,7 @@ Expected<WindowSolveSummary> BundleWindow::solve() {
   out.final_cost = summary.final_cost;
   out.converged = summary.termination_type == ceres::CONVERGENCE;
   updateYawAxis();
+  updateTravelDirection();
   if (post_hook_) post_hook_(*this);
   return out;
 }
@@ -522,8 +530,27 @@ Expected<WindowSolveSummary> BundleWindow::solveSchur(WindowSolveSummary out) {
   out.final_cost = r->final_cost;
   out.converged = r->converged;
   updateYawAxis();
+  updateTravelDirection();
   if (post_hook_) post_hook_(*this);
   return out;
+}
+
+// One sample of the direction of travel per solved step T_k_km1 = [C | t] (TravelDirection):
+// beta = (t_x - psi (t_z / 2 + L)) / t_z, the non-holonomic row solved for beta. Only steps with
+// |t_z| >= sigma_v dt / tan(sigma_mount) count: on a shorter one the vehicle's own sideways
+// velocity hides a turn of the mount as large as its std, and t_z near 0 makes the ratio noise.
+void BundleWindow::updateTravelDirection() {
+  if (travel_.capacity() == 0 || size_ < 2) return;
+  const auto k = static_cast<std::size_t>(size_ - 1);
+  const double dt_s = static_cast<double>(frames_[k].time_ns - frames_[k - 1].time_ns) * 1e-9;
+  if (!(dt_s > 0.0) || !std::isfinite(dt_s)) return;
+  const Isometry3 T_k_km1 = T_k_b(size_ - 1) * T_k_b(size_ - 2).inverse();
+  const Eigen::Vector3d t = T_k_km1.translation();
+  const double tan_mount =
+      std::tan(std::max(options_.lateral_mount_sigma_deg, 0.01) * M_PI / 180.0);
+  if (!(std::abs(t.z()) >= options_.lateral_prior_sigma_m_s * dt_s / tan_mount)) return;
+  const double psi = logSO3(T_k_km1.linear()).y();
+  travel_.push((t.x() - psi * (0.5 * t.z() + options_.lateral_lever_m)) / t.z());
 }
 
 bool BundleWindow::normalizePoses() {

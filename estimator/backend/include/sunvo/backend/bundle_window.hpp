@@ -34,6 +34,7 @@
 #include "sunvo/backend/rate_spread.hpp"
 #include "sunvo/backend/schur_lm_solver.hpp"
 #include "sunvo/backend/stereo_residual.hpp"
+#include "sunvo/backend/travel_direction.hpp"
 #include "sunvo/core/camera.hpp"
 #include "sunvo/core/geometry.hpp"
 #include "sunvo/core/status.hpp"
@@ -92,6 +93,10 @@ struct WindowOptions {
   double lateral_lever_m = 0.0;          // m, [-10, 10]: the camera ahead of the rear axle
   double lateral_lever_sigma_m = 0.1;    // m, [0, 10]: the lever arm's std
   double lateral_mount_sigma_deg = 2.0;  // deg, [0, 45]: the camera axis against the vehicle's
+  // The direction of travel beta (the row's t_z slope, TravelDirection) as the median over the
+  // last N solved steps long enough for the mount angle to show above the sideways velocity
+  // (|t_z| >= lateral_prior_sigma_m_s dt / tan(lateral_mount_sigma_deg)); 0 = beta stays 0.
+  int lateral_beta_frames = 200;  // steps, [0, TravelDirection::kMaxFrames]
   // Zero-mean prior on each window frame's rotation relative to the previous window frame
   // (issue 15; RotationRatePriorResidual) along the pitch-like and roll-like directions
   // orthogonal to the vehicle's yaw axis: std = rate std x dt, dt from the frame times (no prior
@@ -141,6 +146,7 @@ struct WindowOptions {
     v("lateral_lever_m", s.lateral_lever_m);
     v("lateral_lever_sigma_m", s.lateral_lever_sigma_m);
     v("lateral_mount_sigma_deg", s.lateral_mount_sigma_deg);
+    v("lateral_beta_frames", s.lateral_beta_frames);
     v("rotation_rate_prior", s.rotation_rate_prior);
     v("rate_prior_pitch_deg_s", s.rate_prior_pitch_deg_s);
     v("rate_prior_yaw_deg_s", s.rate_prior_yaw_deg_s);
@@ -207,6 +213,7 @@ class BundleWindow {
     yaw_scatter_ = saved_yaw_scatter_;
     yaw_axis_c_ = saved_yaw_axis_c_;
     rate_spread_.undoLastPush();
+    travel_.undoLastPush();
   }
 
   int size() const { return size_; }
@@ -248,6 +255,9 @@ class BundleWindow {
   // The vehicle's yaw (turn) axis in the camera frame as estimated so far (unit, y >= 0); the
   // rotation-rate prior acts orthogonal to it. Kept across reset() (a property of the rig).
   const Eigen::Vector3d& yawAxis() const { return yaw_axis_c_; }
+  // The direction of travel the non-holonomic row uses for the next frame, rad (0 until learnt;
+  // lateral_beta_frames). Kept across reset() (a property of the rig).
+  double lateralBeta() const { return travel_.beta(); }
 
   // Time limit of the following solves, s: a real-time caller shrinks it when a frame is late.
   // Clamped to (0, options.max_solver_time_in_seconds]; a non-finite or non-positive value
@@ -284,6 +294,8 @@ class BundleWindow {
   Status addRatePriors(WindowSolveSummary& out, bool use_ceres);
   // Adds the newest frame's relative rotation to the yaw-axis estimate (after a solve).
   void updateYawAxis();
+  // Adds the newest frame's direction of travel to travel_ (after a solve).
+  void updateTravelDirection();
 
   WindowOptions options_;
   double time_budget_s_ = 0.0;  // limit of the next solve, (0, options_.max_solver_time_in_seconds]
@@ -315,6 +327,7 @@ class BundleWindow {
   Eigen::Matrix3d saved_yaw_scatter_ = Eigen::Matrix3d::Zero();  // before the last solve
   Eigen::Vector3d saved_yaw_axis_c_ = Eigen::Vector3d::UnitY();
   RateSpread rate_spread_;  // the solved rates about the prior's axes (rate_prior_adapt_frames)
+  TravelDirection travel_;  // the solved steps' direction of travel (lateral_beta_frames)
   int num_extra_ = 0;
 };
 

@@ -89,6 +89,10 @@ void addWindowPriorOptions(CLI::App& app, WindowOptions& win) {
                  "non-holonomic prior: how well the camera axis is aligned with the vehicle's, deg "
                  "(window.lateral_mount_sigma_deg)")
       ->check(CLI::Range(0.0, 45.0));
+  app.add_option("--beta-frames", win.lateral_beta_frames,
+                 "non-holonomic prior: learn the camera's direction of travel as the median over "
+                 "this many solved steps (window.lateral_beta_frames; 0 = straight ahead)")
+      ->check(CLI::Range(0, 1024));
   app.add_flag(
       "!--no-rate-prior", win.rotation_rate_prior,
       "VO without the window's zero-mean rotation-rate prior (window.rotation_rate_prior)");
