@@ -508,8 +508,7 @@ Expected<WindowSolveSummary> BundleWindow::solve() {
   out.initial_cost = summary.initial_cost;
   out.final_cost = summary.final_cost;
   out.converged = summary.termination_type == ceres::CONVERGENCE;
-  updateYawAxis();
-  updateTravelDirection();
+  learnFromNewestStep();
   if (post_hook_) post_hook_(*this);
   return out;
 }
@@ -529,27 +528,31 @@ Expected<WindowSolveSummary> BundleWindow::solveSchur(WindowSolveSummary out) {
   out.initial_cost = r->initial_cost;
   out.final_cost = r->final_cost;
   out.converged = r->converged;
-  updateYawAxis();
-  updateTravelDirection();
+  learnFromNewestStep();
   if (post_hook_) post_hook_(*this);
   return out;
+}
+
+void BundleWindow::learnFromNewestStep() {
+  if (size_ < 2) return;
+  const auto k = static_cast<std::size_t>(size_ - 1);
+  const double dt_s = static_cast<double>(frames_[k].time_ns - frames_[k - 1].time_ns) * 1e-9;
+  if (!(dt_s > 0.0) || !std::isfinite(dt_s)) return;
+  const Isometry3 T_k_km1 = T_k_b(size_ - 1) * T_k_b(size_ - 2).inverse();
+  const Eigen::Vector3d phi = logSO3(T_k_km1.linear());
+  updateYawAxis(dt_s, phi);
+  updateTravelDirection(dt_s, T_k_km1.translation(), phi.y());
 }
 
 // One sample of the direction of travel per solved step T_k_km1 = [C | t] (TravelDirection):
 // beta = (t_x - psi (t_z / 2 + L)) / t_z, the non-holonomic row solved for beta. Only steps with
 // |t_z| >= sigma_v dt / tan(sigma_mount) count: on a shorter one the vehicle's own sideways
 // velocity hides a turn of the mount as large as its std, and t_z near 0 makes the ratio noise.
-void BundleWindow::updateTravelDirection() {
-  if (travel_.capacity() == 0 || size_ < 2) return;
-  const auto k = static_cast<std::size_t>(size_ - 1);
-  const double dt_s = static_cast<double>(frames_[k].time_ns - frames_[k - 1].time_ns) * 1e-9;
-  if (!(dt_s > 0.0) || !std::isfinite(dt_s)) return;
-  const Isometry3 T_k_km1 = T_k_b(size_ - 1) * T_k_b(size_ - 2).inverse();
-  const Eigen::Vector3d t = T_k_km1.translation();
+void BundleWindow::updateTravelDirection(double dt_s, const Eigen::Vector3d& t, double psi) {
+  if (travel_.capacity() == 0) return;
   const double tan_mount =
       std::tan(std::max(options_.lateral_mount_sigma_deg, 0.01) * M_PI / 180.0);
   if (!(std::abs(t.z()) >= options_.lateral_prior_sigma_m_s * dt_s / tan_mount)) return;
-  const double psi = logSO3(T_k_km1.linear()).y();
   travel_.push((t.x() - psi * (0.5 * t.z() + options_.lateral_lever_m)) / t.z());
 }
 

@@ -70,13 +70,8 @@ Status BundleWindow::addRatePriors(WindowSolveSummary& out, bool use_ceres) {
 // dominate M: a 3 deg/frame turn weighs 900 times a 0.1 deg/frame wobble), lambda = exp(-dt / tau).
 // The regulariser w0^2 y y^T is kept at a constant weight, so that without turns the axis
 // returns to the camera's y axis.
-void BundleWindow::updateYawAxis() {
-  if (size_ < 2) return;
-  const auto k = static_cast<std::size_t>(size_ - 1);
-  const double dt_s = static_cast<double>(frames_[k].time_ns - frames_[k - 1].time_ns) * 1e-9;
-  const Isometry3 T_k_km1 = T_k_b(size_ - 1) * T_k_b(size_ - 2).inverse();
-  const Eigen::Vector3d phi = logSO3(T_k_km1.linear());
-  if (!phi.allFinite() || !(dt_s > 0.0) || !std::isfinite(dt_s)) return;
+void BundleWindow::updateYawAxis(double dt_s, const Eigen::Vector3d& phi) {
+  if (!phi.allFinite()) return;
   // The rate about the prior's axes as they were in this solve (before the axis moves).
   rate_spread_.push(rateBasis(yaw_axis_c_) * phi / std::max(dt_s, 1e-3));
   const double lambda = std::exp(-dt_s / options_.yaw_axis_memory_s);

@@ -292,10 +292,12 @@ class BundleWindow {
   void clearResiduals();
   // Sets the rotation-rate priors' bases and weights from the frame times and the yaw axis.
   Status addRatePriors(WindowSolveSummary& out, bool use_ceres);
-  // Adds the newest frame's relative rotation to the yaw-axis estimate (after a solve).
-  void updateYawAxis();
-  // Adds the newest frame's direction of travel to travel_ (after a solve).
-  void updateTravelDirection();
+  // After a solve: the newest frame's step relative to the previous window frame (over dt_s > 0)
+  // feeds the yaw-axis estimate and the rate spread (updateYawAxis, its rotation vector phi) and
+  // travel_ (updateTravelDirection, its translation t and yaw psi).
+  void learnFromNewestStep();
+  void updateYawAxis(double dt_s, const Eigen::Vector3d& phi);
+  void updateTravelDirection(double dt_s, const Eigen::Vector3d& t, double psi);
 
   WindowOptions options_;
   double time_budget_s_ = 0.0;  // limit of the next solve, (0, options_.max_solver_time_in_seconds]
