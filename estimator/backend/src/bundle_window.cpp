@@ -43,6 +43,7 @@ Status WindowOptions::validate() const {
         std::tuple{"lateral_lever_m", lateral_lever_m, -10.0, 10.0, "[-10, 10]"},
         std::tuple{"lateral_lever_sigma_m", lateral_lever_sigma_m, 0.0, 10.0, "[0, 10]"},
         std::tuple{"lateral_mount_sigma_deg", lateral_mount_sigma_deg, 0.0, 45.0, "[0, 45]"},
+        std::tuple{"vertical_prior_sigma_m_s", vertical_prior_sigma_m_s, 0.0, 100.0, "[0, 100]"},
         std::tuple{"rate_prior_pitch_deg_s", rate_prior_pitch_deg_s, 0.0, 1000.0, "[0, 1000]"},
         std::tuple{"rate_prior_yaw_deg_s", rate_prior_yaw_deg_s, 0.0, 1000.0, "[0, 1000]"},
         std::tuple{"rate_prior_roll_deg_s", rate_prior_roll_deg_s, 0.0, 1000.0, "[0, 1000]"}}) {
@@ -55,9 +56,12 @@ Status WindowOptions::validate() const {
         "window.motion_prior_sigma_trans_m and window.motion_prior_sigma_accel_m_s2 are two forms "
         "of one std: set one of them to 0");
   }
-  if (lateral_beta_frames < 0 || lateral_beta_frames > TravelDirection::kMaxFrames) {
-    return invalidArgument("window.lateral_beta_frames must be in [0, " +
-                           std::to_string(TravelDirection::kMaxFrames) + "]");
+  for (const auto& [key, frames] : {std::pair{"lateral_beta_frames", lateral_beta_frames},
+                                    std::pair{"vertical_gamma_frames", vertical_gamma_frames}}) {
+    if (frames < 0 || frames > TravelDirection::kMaxFrames) {
+      return invalidArgument(std::string("window.") + key + " must be in [0, " +
+                             std::to_string(TravelDirection::kMaxFrames) + "]");
+    }
   }
   if (rate_prior_adapt_frames < 0 || rate_prior_adapt_frames > RateSpread::kMaxFrames) {
     return invalidArgument("window.rate_prior_adapt_frames must be in [0, " +
@@ -117,7 +121,8 @@ Status BundleWindow::init(const WindowOptions& options, const StereoCamera& came
   saved_yaw_scatter_ = yaw_scatter_;
   saved_yaw_axis_c_ = yaw_axis_c_;
   rate_spread_.setCapacity(options.rate_prior_adapt_frames);
-  travel_.setCapacity(options.lateral_prior_sigma_m_s > 0.0 ? options.lateral_beta_frames : 0);
+  travel_x_.setCapacity(options.lateral_prior_sigma_m_s > 0.0 ? options.lateral_beta_frames : 0);
+  travel_y_.setCapacity(options.vertical_prior_sigma_m_s > 0.0 ? options.vertical_gamma_frames : 0);
   num_residuals_ = 0;
 
   switch (options.loss) {
@@ -245,18 +250,9 @@ Status BundleWindow::addFrame(std::uint64_t sequence, TimeNs time_ns,
   const bool predicted = slot > 0 && motion_prior != nullptr &&
                          (options_.motion_prior_sigma_rot_deg > 0.0 || s_trans > 0.0) &&
                          allFinite(*motion_prior);
-  // The sideways row's std: the vehicle's own sideways velocity over dt, widened by what the
-  // model's two parameters leave open for this step (t_z and psi of the initial guess).
-  double s_lat = 0.0;
-  if (slot > 0 && options_.lateral_prior_sigma_m_s > 0.0 && dt > 0.0) {
-    s_lat = std::hypot(
-        options_.lateral_prior_sigma_m_s * dt,
-        options_.lateral_mount_sigma_deg * M_PI / 180.0 * T_k_km1_guess.translation().z(),
-        options_.lateral_lever_sigma_m * logSO3(T_k_km1_guess.linear()).y());
-  }
-  const bool lateral = s_lat > 0.0 && std::isfinite(s_lat);
-  f.has_prior = predicted || lateral;
   f.prior = MotionPriorData{};
+  const bool travel = slot > 0 && setTravelRows(dt, T_k_km1_guess, f.prior);
+  f.has_prior = predicted || travel;
   if (predicted) {
     const Eigen::Quaterniond q(motion_prior->linear());
     f.prior.q_pred[0] = q.x();
@@ -269,11 +265,6 @@ Status BundleWindow::addFrame(std::uint64_t sequence, TimeNs time_ns,
   const double s_rot = options_.motion_prior_sigma_rot_deg * M_PI / 180.0;
   f.prior.sqrt_info_rot = predicted && s_rot > 0.0 ? 1.0 / s_rot : 0.0;
   f.prior.sqrt_info_trans = predicted && s_trans > 0.0 ? 1.0 / s_trans : 0.0;
-  if (lateral) {  // beta is 0 until learnt; the mount's turn is in s_lat either way
-    f.prior.lateral_beta = travel_.beta();
-    f.prior.lateral_lever_m = options_.lateral_lever_m;
-    f.prior.sqrt_info_lateral = 1.0 / s_lat;
-  }
   if (slot == 0) {
     poses_[0] = PoseBlock{};
   } else {
@@ -477,7 +468,8 @@ Expected<WindowSolveSummary> BundleWindow::solve() {
   saved_yaw_scatter_ = yaw_scatter_;
   saved_yaw_axis_c_ = yaw_axis_c_;
   rate_spread_.commit();
-  travel_.commit();
+  travel_x_.commit();
+  travel_y_.commit();
   if (hook_) {
     in_hook_ = true;
     const Status s = hook_(*this);
@@ -541,19 +533,7 @@ void BundleWindow::learnFromNewestStep() {
   const Isometry3 T_k_km1 = T_k_b(size_ - 1) * T_k_b(size_ - 2).inverse();
   const Eigen::Vector3d phi = logSO3(T_k_km1.linear());
   updateYawAxis(dt_s, phi);
-  updateTravelDirection(dt_s, T_k_km1.translation(), phi.y());
-}
-
-// One sample of the direction of travel per solved step T_k_km1 = [C | t] (TravelDirection):
-// beta = (t_x - psi (t_z / 2 + L)) / t_z, the non-holonomic row solved for beta. Only steps with
-// |t_z| >= sigma_v dt / tan(sigma_mount) count: on a shorter one the vehicle's own sideways
-// velocity hides a turn of the mount as large as its std, and t_z near 0 makes the ratio noise.
-void BundleWindow::updateTravelDirection(double dt_s, const Eigen::Vector3d& t, double psi) {
-  if (travel_.capacity() == 0) return;
-  const double tan_mount =
-      std::tan(std::max(options_.lateral_mount_sigma_deg, 0.01) * M_PI / 180.0);
-  if (!(std::abs(t.z()) >= options_.lateral_prior_sigma_m_s * dt_s / tan_mount)) return;
-  travel_.push((t.x() - psi * (0.5 * t.z() + options_.lateral_lever_m)) / t.z());
+  updateTravelDirection(dt_s, T_k_km1.translation(), phi);
 }
 
 bool BundleWindow::normalizePoses() {

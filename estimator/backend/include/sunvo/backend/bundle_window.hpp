@@ -81,7 +81,7 @@ struct WindowOptions {
   // and sideways step trading against each other, is held to the last step; it does not hold the
   // rotation to the last rotation, whose error a rotation prior would repeat frame after frame.
   double motion_prior_sigma_accel_m_s2 = 7.0;  // m/s^2, [0, 1000]: 0 = off
-  // Non-holonomic prior (docs/lateral_prior.md; MotionPriorResidual's last row): a wheeled
+  // Non-holonomic prior (docs/lateral_prior.md; MotionPriorResidual's lateral row): a wheeled
   // vehicle that does not skid steps sideways only as much as its own turn and the camera's lever
   // arm ahead of the rear axle imply. Each frame's sideways step is held to that with std
   //   hypot(lateral_prior_sigma_m_s dt, |t_z| mount_sigma, |psi| lateral_lever_sigma_m)
@@ -97,6 +97,14 @@ struct WindowOptions {
   // last N solved steps long enough for the mount angle to show above the sideways velocity
   // (|t_z| >= lateral_prior_sigma_m_s dt / tan(lateral_mount_sigma_deg)); 0 = beta stays 0.
   int lateral_beta_frames = 200;  // steps, [0, TravelDirection::kMaxFrames]
+  // The same prior in the camera's vertical plane (MotionPriorResidual's vertical row): a vehicle
+  // on the road steps along its body axis as it pitches, t_y = gamma t_z - theta t_z / 2, with std
+  //   hypot(vertical_prior_sigma_m_s dt, |t_z| mount_sigma)
+  // (its own vertical velocity against the body: suspension, bumps; the mount as above). gamma,
+  // the camera's pitch against the direction of travel, is learnt like beta over the last
+  // vertical_gamma_frames steps (0 = gamma stays 0). Off for a vehicle that leaves the ground.
+  double vertical_prior_sigma_m_s = 0.0;  // m/s, [0, 100]: 0 = off
+  int vertical_gamma_frames = 200;        // steps, [0, TravelDirection::kMaxFrames]
   // Zero-mean prior on each window frame's rotation relative to the previous window frame
   // (issue 15; RotationRatePriorResidual) along the pitch-like and roll-like directions
   // orthogonal to the vehicle's yaw axis: std = rate std x dt, dt from the frame times (no prior
@@ -147,6 +155,8 @@ struct WindowOptions {
     v("lateral_lever_sigma_m", s.lateral_lever_sigma_m);
     v("lateral_mount_sigma_deg", s.lateral_mount_sigma_deg);
     v("lateral_beta_frames", s.lateral_beta_frames);
+    v("vertical_prior_sigma_m_s", s.vertical_prior_sigma_m_s);
+    v("vertical_gamma_frames", s.vertical_gamma_frames);
     v("rotation_rate_prior", s.rotation_rate_prior);
     v("rate_prior_pitch_deg_s", s.rate_prior_pitch_deg_s);
     v("rate_prior_yaw_deg_s", s.rate_prior_yaw_deg_s);
@@ -213,7 +223,8 @@ class BundleWindow {
     yaw_scatter_ = saved_yaw_scatter_;
     yaw_axis_c_ = saved_yaw_axis_c_;
     rate_spread_.undoLastPush();
-    travel_.undoLastPush();
+    travel_x_.undoLastPush();
+    travel_y_.undoLastPush();
   }
 
   int size() const { return size_; }
@@ -257,7 +268,9 @@ class BundleWindow {
   const Eigen::Vector3d& yawAxis() const { return yaw_axis_c_; }
   // The direction of travel the non-holonomic row uses for the next frame, rad (0 until learnt;
   // lateral_beta_frames). Kept across reset() (a property of the rig).
-  double lateralBeta() const { return travel_.beta(); }
+  double lateralBeta() const { return travel_x_.beta(); }
+  // The same for the vertical row's gamma (vertical_gamma_frames).
+  double verticalGamma() const { return travel_y_.beta(); }
 
   // Time limit of the following solves, s: a real-time caller shrinks it when a frame is late.
   // Clamped to (0, options.max_solver_time_in_seconds]; a non-finite or non-positive value
@@ -294,10 +307,13 @@ class BundleWindow {
   Status addRatePriors(WindowSolveSummary& out, bool use_ceres);
   // After a solve: the newest frame's step relative to the previous window frame (over dt_s > 0)
   // feeds the yaw-axis estimate and the rate spread (updateYawAxis, its rotation vector phi) and
-  // travel_ (updateTravelDirection, its translation t and yaw psi).
+  // the directions of travel (updateTravelDirection, its translation t and phi).
   void learnFromNewestStep();
   void updateYawAxis(double dt_s, const Eigen::Vector3d& phi);
-  void updateTravelDirection(double dt_s, const Eigen::Vector3d& t, double psi);
+  void updateTravelDirection(double dt_s, const Eigen::Vector3d& t, const Eigen::Vector3d& phi);
+  // The non-holonomic rows of a frame dt_s after the previous one (bundle_window_travel.cpp):
+  // their weights and learnt slopes into prior; false when neither row is on.
+  bool setTravelRows(double dt_s, const Isometry3& T_k_km1_guess, MotionPriorData& prior) const;
 
   WindowOptions options_;
   double time_budget_s_ = 0.0;  // limit of the next solve, (0, options_.max_solver_time_in_seconds]
@@ -329,7 +345,10 @@ class BundleWindow {
   Eigen::Matrix3d saved_yaw_scatter_ = Eigen::Matrix3d::Zero();  // before the last solve
   Eigen::Vector3d saved_yaw_axis_c_ = Eigen::Vector3d::UnitY();
   RateSpread rate_spread_;  // the solved rates about the prior's axes (rate_prior_adapt_frames)
-  TravelDirection travel_;  // the solved steps' direction of travel (lateral_beta_frames)
+  // The solved steps' direction of travel, x over z (lateral_beta_frames) and y over z
+  // (vertical_gamma_frames).
+  TravelDirection travel_x_;
+  TravelDirection travel_y_;
   int num_extra_ = 0;
 };
 

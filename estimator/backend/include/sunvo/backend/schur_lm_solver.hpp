@@ -62,7 +62,7 @@ class SchurLmSolver {
   static constexpr int kMaxPoses = 8;          // window slots, slot 0 constant
   static constexpr int kMaxExtraBlocks = 4;    // distinct caller blocks per solve
   static constexpr int kMaxExtraDim = 12;      // their summed sizes
-  static constexpr int kMaxGenericRows = 7;    // rows of one non-stereo residual
+  static constexpr int kMaxGenericRows = 8;    // rows of one non-stereo residual
   static constexpr int kMaxGenericBlocks = 5;  // parameter blocks of one non-stereo residual
   static constexpr int kMaxReducedDim = 6 * (kMaxPoses - 1) + kMaxExtraDim;
 

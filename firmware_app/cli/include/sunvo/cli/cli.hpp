@@ -93,6 +93,14 @@ void addWindowPriorOptions(CLI::App& app, WindowOptions& win) {
                  "non-holonomic prior: learn the camera's direction of travel as the median over "
                  "this many solved steps (window.lateral_beta_frames; 0 = straight ahead)")
       ->check(CLI::Range(0, 1024));
+  app.add_option("--vertical-prior", win.vertical_prior_sigma_m_s,
+                 "non-holonomic prior in the vertical plane: std of the camera's vertical velocity "
+                 "about the vehicle's body axis, m/s (window.vertical_prior_sigma_m_s; 0 = off)")
+      ->check(CLI::Range(0.0, 100.0));
+  app.add_option("--gamma-frames", win.vertical_gamma_frames,
+                 "vertical prior: learn the camera's pitch against the direction of travel as the "
+                 "median over this many solved steps (window.vertical_gamma_frames; 0 = level)")
+      ->check(CLI::Range(0, 1024));
   app.add_flag(
       "!--no-rate-prior", win.rotation_rate_prior,
       "VO without the window's zero-mean rotation-rate prior (window.rotation_rate_prior)");

@@ -1,0 +1,64 @@
+// The window's non-holonomic rows (WindowOptions::lateral_prior_sigma_m_s and
+// vertical_prior_sigma_m_s; MotionPriorResidual; docs/lateral_prior.md): their per-frame stds and
+// the directions of travel they are built around, learnt from the solved steps. Part of
+// BundleWindow, kept apart from bundle_window.cpp by topic.
+#include <algorithm>
+#include <cmath>
+
+#include "sunvo/backend/bundle_window.hpp"
+
+namespace sunvo::backend {
+
+// Each row's std: the vehicle's own velocity across its body axis over dt, widened by what the
+// model's parameters leave open for this step (t_z and, sideways, psi of the initial guess): a
+// mount known to within its std, and a lever arm known to within its std. The slopes (beta, gamma)
+// are 0 until learnt; the mount's turn is in the std either way.
+bool BundleWindow::setTravelRows(double dt_s, const Isometry3& T_k_km1_guess,
+                                 MotionPriorData& prior) const {
+  if (!(dt_s > 0.0)) return false;
+  const double mount_rad = options_.lateral_mount_sigma_deg * M_PI / 180.0;
+  const double t_z = T_k_km1_guess.translation().z();
+  bool any = false;
+  if (options_.lateral_prior_sigma_m_s > 0.0) {
+    const double s_lat =
+        std::hypot(options_.lateral_prior_sigma_m_s * dt_s, mount_rad * t_z,
+                   options_.lateral_lever_sigma_m * logSO3(T_k_km1_guess.linear()).y());
+    if (s_lat > 0.0 && std::isfinite(s_lat)) {
+      prior.lateral_beta = travel_x_.beta();
+      prior.lateral_lever_m = options_.lateral_lever_m;
+      prior.sqrt_info_lateral = 1.0 / s_lat;
+      any = true;
+    }
+  }
+  if (options_.vertical_prior_sigma_m_s > 0.0) {
+    const double s_vert = std::hypot(options_.vertical_prior_sigma_m_s * dt_s, mount_rad * t_z);
+    if (s_vert > 0.0 && std::isfinite(s_vert)) {
+      prior.vertical_gamma = travel_y_.beta();
+      prior.sqrt_info_vertical = 1.0 / s_vert;
+      any = true;
+    }
+  }
+  return any;
+}
+
+// One sample of each direction of travel per solved step T_k_km1 = [C | t], phi = log(C)
+// (TravelDirection): the rows solved for their slopes,
+//   beta = (t_x - psi (t_z / 2 + L)) / t_z,  gamma = (t_y + theta t_z / 2) / t_z,
+// psi = phi_y, theta = phi_x. Only steps with |t_z| >= sigma dt / tan(sigma_mount) count (sigma the
+// row's velocity std): on a shorter one the vehicle's own velocity across its axis hides a turn of
+// the mount as large as its std, and t_z near 0 makes the ratio noise.
+void BundleWindow::updateTravelDirection(double dt_s, const Eigen::Vector3d& t,
+                                         const Eigen::Vector3d& phi) {
+  const double tan_mount =
+      std::tan(std::max(options_.lateral_mount_sigma_deg, 0.01) * M_PI / 180.0);
+  if (travel_x_.capacity() > 0 &&
+      std::abs(t.z()) >= options_.lateral_prior_sigma_m_s * dt_s / tan_mount) {
+    travel_x_.push((t.x() - phi.y() * (0.5 * t.z() + options_.lateral_lever_m)) / t.z());
+  }
+  if (travel_y_.capacity() > 0 &&
+      std::abs(t.z()) >= options_.vertical_prior_sigma_m_s * dt_s / tan_mount) {
+    travel_y_.push((t.y() + 0.5 * phi.x() * t.z()) / t.z());
+  }
+}
+
+}  // namespace sunvo::backend
