@@ -249,6 +249,49 @@ TEST(VerticalPrior, LearnsTheCamerasPitchAgainstTheTravel) {
   EXPECT_LT(std::abs(bias[1]), 0.5 * std::abs(bias[0]));
 }
 
+// The conditioning rule (WindowOptions::vertical_prior_near_m): a frame with a track nearer than
+// the limit is solved without the row, exactly as with the row off; without that track, or with
+// the limit at 0, the row pulls the step (gamma held at 0 against a camera pitched by 20 mrad).
+TEST(VerticalPrior, LeavesOutFramesWithANearTrack) {
+  const StereoCamera cam = kittiCamera();
+  const Isometry3 T_k_km1 = crestStep(1.2, 0.0, 0.02);
+  // Solves one pair (the facade of solvePair, noise-free) with or without a track at 5 m.
+  const auto solve = [&](double sigma_m_s, double near_m, bool near_track) {
+    WindowOptions wo;
+    wo.rotation_rate_prior = false;
+    wo.motion_prior_sigma_accel_m_s2 = 0.0;
+    wo.vertical_prior_sigma_m_s = sigma_m_s;
+    wo.vertical_gamma_frames = 0;
+    wo.vertical_prior_near_m = near_m;
+    BundleWindow w;
+    EXPECT_TRUE(w.init(wo, cam).isOk());
+    w.reset(Isometry3::Identity());
+    std::vector<WindowObservation> a, b;
+    for (int i = 0; i < 30; ++i) {
+      const Eigen::Vector3d p(6.0 + 0.1 * i, -2.0 + 0.1 * (i % 7), 18.0 + 0.2 * i);
+      const Eigen::Vector3d y0 = cam.project(p);
+      const Eigen::Vector3d y1 = cam.project(T_k_km1 * p);
+      a.push_back({i, {y0.x(), y0.y(), y0.z()}});
+      b.push_back({i, {y1.x() + 0.3 * ((i % 3) - 1), y1.y() + 0.2 * ((i % 5) - 2), y1.z()}});
+    }
+    if (near_track) {
+      const Eigen::Vector3d p(-1.0, 0.5, 6.0);
+      const Eigen::Vector3d y0 = cam.project(p);
+      const Eigen::Vector3d y1 = cam.project(T_k_km1 * p);
+      a.push_back({100, {y0.x(), y0.y(), y0.z()}});
+      b.push_back({100, {y1.x(), y1.y(), y1.z()}});
+    }
+    EXPECT_TRUE(w.addFrame(0, 0, a, Isometry3::Identity()).isOk());
+    EXPECT_TRUE(w.addFrame(1, 100'000'000, b, T_k_km1).isOk());
+    EXPECT_TRUE(w.solve().hasValue());
+    return w.T_k_b(1);
+  };
+  const auto same = [](const Isometry3& x, const Isometry3& y) { return x.isApprox(y, 1e-12); };
+  EXPECT_TRUE(same(solve(0.1, 8.0, true), solve(0.0, 8.0, true)));     // left out
+  EXPECT_FALSE(same(solve(0.1, 0.0, true), solve(0.0, 0.0, true)));    // no rule: the row acts
+  EXPECT_FALSE(same(solve(0.1, 8.0, false), solve(0.0, 8.0, false)));  // nothing near
+}
+
 TEST(LateralPrior, ValidationNamesTheKey) {
   WindowOptions wo;
   wo.lateral_prior_sigma_m_s = -1.0;
@@ -268,6 +311,13 @@ TEST(LateralPrior, ValidationNamesTheKey) {
   wo.vertical_prior_sigma_m_s = 101.0;
   EXPECT_NE(wo.validate().message().find("window.vertical_prior_sigma_m_s must be in [0, 100]"),
             std::string::npos);
+  wo = WindowOptions{};
+  wo.vertical_prior_near_m = -1.0;
+  EXPECT_NE(wo.validate().message().find("window.vertical_prior_near_m must be in [0, 1000]"),
+            std::string::npos);
+  wo = WindowOptions{};
+  wo.lateral_prior_near_m = std::nan("");
+  EXPECT_NE(wo.validate().message().find("window.lateral_prior_near_m"), std::string::npos);
   wo = WindowOptions{};
   wo.vertical_gamma_frames = -1;
   EXPECT_NE(wo.validate().message().find("window.vertical_gamma_frames must be in [0, 1024]"),

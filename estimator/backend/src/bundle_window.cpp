@@ -44,6 +44,8 @@ Status WindowOptions::validate() const {
         std::tuple{"lateral_lever_sigma_m", lateral_lever_sigma_m, 0.0, 10.0, "[0, 10]"},
         std::tuple{"lateral_mount_sigma_deg", lateral_mount_sigma_deg, 0.0, 45.0, "[0, 45]"},
         std::tuple{"vertical_prior_sigma_m_s", vertical_prior_sigma_m_s, 0.0, 100.0, "[0, 100]"},
+        std::tuple{"lateral_prior_near_m", lateral_prior_near_m, 0.0, 1000.0, "[0, 1000]"},
+        std::tuple{"vertical_prior_near_m", vertical_prior_near_m, 0.0, 1000.0, "[0, 1000]"},
         std::tuple{"rate_prior_pitch_deg_s", rate_prior_pitch_deg_s, 0.0, 1000.0, "[0, 1000]"},
         std::tuple{"rate_prior_yaw_deg_s", rate_prior_yaw_deg_s, 0.0, 1000.0, "[0, 1000]"},
         std::tuple{"rate_prior_roll_deg_s", rate_prior_roll_deg_s, 0.0, 1000.0, "[0, 1000]"}}) {
@@ -251,7 +253,7 @@ Status BundleWindow::addFrame(std::uint64_t sequence, TimeNs time_ns,
                          (options_.motion_prior_sigma_rot_deg > 0.0 || s_trans > 0.0) &&
                          allFinite(*motion_prior);
   f.prior = MotionPriorData{};
-  const bool travel = slot > 0 && setTravelRows(dt, T_k_km1_guess, f.prior);
+  const bool travel = slot > 0 && setTravelRows(dt, T_k_km1_guess, obs, f.prior);
   f.has_prior = predicted || travel;
   if (predicted) {
     const Eigen::Quaterniond q(motion_prior->linear());

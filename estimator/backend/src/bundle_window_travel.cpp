@@ -12,14 +12,22 @@ namespace sunvo::backend {
 // Each row's std: the vehicle's own velocity across its body axis over dt, widened by what the
 // model's parameters leave open for this step (t_z and, sideways, psi of the initial guess): a
 // mount known to within its std, and a lever arm known to within its std. The slopes (beta, gamma)
-// are 0 until learnt; the mount's turn is in the std either way.
+// are 0 until learnt; the mount's turn is in the std either way. A row is left out of a frame
+// with a track nearer than its *_prior_near_m (depth fu b / d from the track's disparity d).
 bool BundleWindow::setTravelRows(double dt_s, const Isometry3& T_k_km1_guess,
+                                 std::span<const WindowObservation> obs,
                                  MotionPriorData& prior) const {
   if (!(dt_s > 0.0)) return false;
   const double mount_rad = options_.lateral_mount_sigma_deg * M_PI / 180.0;
   const double t_z = T_k_km1_guess.translation().z();
+  double d_max = 0.0;  // px, the nearest track's disparity
+  for (const WindowObservation& o : obs) d_max = std::max(d_max, o.y.d);
+  // Whether no track is nearer than near_m (0 = no condition).
+  const auto noneNearer = [&](double near_m) {
+    return near_m <= 0.0 || d_max * near_m <= model_.fu * model_.baseline_m;
+  };
   bool any = false;
-  if (options_.lateral_prior_sigma_m_s > 0.0) {
+  if (options_.lateral_prior_sigma_m_s > 0.0 && noneNearer(options_.lateral_prior_near_m)) {
     const double s_lat =
         std::hypot(options_.lateral_prior_sigma_m_s * dt_s, mount_rad * t_z,
                    options_.lateral_lever_sigma_m * logSO3(T_k_km1_guess.linear()).y());
@@ -30,7 +38,7 @@ bool BundleWindow::setTravelRows(double dt_s, const Isometry3& T_k_km1_guess,
       any = true;
     }
   }
-  if (options_.vertical_prior_sigma_m_s > 0.0) {
+  if (options_.vertical_prior_sigma_m_s > 0.0 && noneNearer(options_.vertical_prior_near_m)) {
     const double s_vert = std::hypot(options_.vertical_prior_sigma_m_s * dt_s, mount_rad * t_z);
     if (s_vert > 0.0 && std::isfinite(s_vert)) {
       prior.vertical_gamma = travel_y_.beta();

@@ -93,6 +93,10 @@ struct WindowOptions {
   double lateral_lever_m = 0.0;          // m, [-10, 10]: the camera ahead of the rear axle
   double lateral_lever_sigma_m = 0.1;    // m, [0, 10]: the lever arm's std
   double lateral_mount_sigma_deg = 2.0;  // deg, [0, 45]: the camera axis against the vehicle's
+  // Conditioning: the row only on frames none of whose tracks is nearer than this. A near track's
+  // parallax separates the sideways step from the yaw, and there the row, whose model error is
+  // correlated over hundreds of frames (docs/lateral_prior.md), would only add its bias.
+  double lateral_prior_near_m = 0.0;  // m, [0, 1000]: 0 = the row on every frame
   // The direction of travel beta (the row's t_z slope, TravelDirection) as the median over the
   // last N solved steps long enough for the mount angle to show above the sideways velocity
   // (|t_z| >= lateral_prior_sigma_m_s dt / tan(lateral_mount_sigma_deg)); 0 = beta stays 0.
@@ -105,6 +109,8 @@ struct WindowOptions {
   // vertical_gamma_frames steps (0 = gamma stays 0). Off for a vehicle that leaves the ground.
   double vertical_prior_sigma_m_s = 0.0;  // m/s, [0, 100]: 0 = off
   int vertical_gamma_frames = 200;        // steps, [0, TravelDirection::kMaxFrames]
+  // As lateral_prior_near_m, for the vertical step against the pitch.
+  double vertical_prior_near_m = 8.0;  // m, [0, 1000]: 0 = the row on every frame
   // Zero-mean prior on each window frame's rotation relative to the previous window frame
   // (issue 15; RotationRatePriorResidual) along the pitch-like and roll-like directions
   // orthogonal to the vehicle's yaw axis: std = rate std x dt, dt from the frame times (no prior
@@ -154,9 +160,11 @@ struct WindowOptions {
     v("lateral_lever_m", s.lateral_lever_m);
     v("lateral_lever_sigma_m", s.lateral_lever_sigma_m);
     v("lateral_mount_sigma_deg", s.lateral_mount_sigma_deg);
+    v("lateral_prior_near_m", s.lateral_prior_near_m);
     v("lateral_beta_frames", s.lateral_beta_frames);
     v("vertical_prior_sigma_m_s", s.vertical_prior_sigma_m_s);
     v("vertical_gamma_frames", s.vertical_gamma_frames);
+    v("vertical_prior_near_m", s.vertical_prior_near_m);
     v("rotation_rate_prior", s.rotation_rate_prior);
     v("rate_prior_pitch_deg_s", s.rate_prior_pitch_deg_s);
     v("rate_prior_yaw_deg_s", s.rate_prior_yaw_deg_s);
@@ -311,9 +319,11 @@ class BundleWindow {
   void learnFromNewestStep();
   void updateYawAxis(double dt_s, const Eigen::Vector3d& phi);
   void updateTravelDirection(double dt_s, const Eigen::Vector3d& t, const Eigen::Vector3d& phi);
-  // The non-holonomic rows of a frame dt_s after the previous one (bundle_window_travel.cpp):
-  // their weights and learnt slopes into prior; false when neither row is on.
-  bool setTravelRows(double dt_s, const Isometry3& T_k_km1_guess, MotionPriorData& prior) const;
+  // The non-holonomic rows of a frame dt_s after the previous one, observed as obs
+  // (bundle_window_travel.cpp): their weights and learnt slopes into prior; false when neither
+  // row is on.
+  bool setTravelRows(double dt_s, const Isometry3& T_k_km1_guess,
+                     std::span<const WindowObservation> obs, MotionPriorData& prior) const;
 
   WindowOptions options_;
   double time_budget_s_ = 0.0;  // limit of the next solve, (0, options_.max_solver_time_in_seconds]

@@ -97,6 +97,14 @@ void addWindowPriorOptions(CLI::App& app, WindowOptions& win) {
                  "non-holonomic prior in the vertical plane: std of the camera's vertical velocity "
                  "about the vehicle's body axis, m/s (window.vertical_prior_sigma_m_s; 0 = off)")
       ->check(CLI::Range(0.0, 100.0));
+  app.add_option("--lateral-near-m", win.lateral_prior_near_m,
+                 "non-holonomic prior: leave the sideways row out of frames with a track nearer "
+                 "than this, m (window.lateral_prior_near_m; 0 = every frame)")
+      ->check(CLI::Range(0.0, 1000.0));
+  app.add_option("--vertical-near-m", win.vertical_prior_near_m,
+                 "vertical prior: leave the row out of frames with a track nearer than this, m "
+                 "(window.vertical_prior_near_m; 0 = every frame)")
+      ->check(CLI::Range(0.0, 1000.0));
   app.add_option("--gamma-frames", win.vertical_gamma_frames,
                  "vertical prior: learn the camera's pitch against the direction of travel as the "
                  "median over this many solved steps (window.vertical_gamma_frames; 0 = level)")
