@@ -17,17 +17,23 @@ namespace sunvo::backend {
 bool BundleWindow::setTravelRows(double dt_s, const Isometry3& T_k_km1_guess,
                                  std::span<const WindowObservation> obs,
                                  MotionPriorData& prior) const {
-  if (!(dt_s > 0.0)) return false;
+  const bool lateral_on = options_.lateral_prior_sigma_m_s > 0.0;
+  const bool vertical_on = options_.vertical_prior_sigma_m_s > 0.0;
+  if (!(dt_s > 0.0) || !(lateral_on || vertical_on)) return false;
   const double mount_rad = options_.lateral_mount_sigma_deg * M_PI / 180.0;
   const double t_z = T_k_km1_guess.translation().z();
-  double d_max = 0.0;  // px, the nearest track's disparity
-  for (const WindowObservation& o : obs) d_max = std::max(d_max, o.y.d);
+  // The nearest track's disparity, px: looked at only when an active row has a near rule.
+  double d_max = 0.0;
+  if ((lateral_on && options_.lateral_prior_near_m > 0.0) ||
+      (vertical_on && options_.vertical_prior_near_m > 0.0)) {
+    for (const WindowObservation& o : obs) d_max = std::max(d_max, o.y.d);
+  }
   // Whether no track is nearer than near_m (0 = no condition).
   const auto noneNearer = [&](double near_m) {
     return near_m <= 0.0 || d_max * near_m <= model_.fu * model_.baseline_m;
   };
   bool any = false;
-  if (options_.lateral_prior_sigma_m_s > 0.0 && noneNearer(options_.lateral_prior_near_m)) {
+  if (lateral_on && noneNearer(options_.lateral_prior_near_m)) {
     const double s_lat =
         std::hypot(options_.lateral_prior_sigma_m_s * dt_s, mount_rad * t_z,
                    options_.lateral_lever_sigma_m * logSO3(T_k_km1_guess.linear()).y());
@@ -38,7 +44,7 @@ bool BundleWindow::setTravelRows(double dt_s, const Isometry3& T_k_km1_guess,
       any = true;
     }
   }
-  if (options_.vertical_prior_sigma_m_s > 0.0 && noneNearer(options_.vertical_prior_near_m)) {
+  if (vertical_on && noneNearer(options_.vertical_prior_near_m)) {
     const double s_vert = std::hypot(options_.vertical_prior_sigma_m_s * dt_s, mount_rad * t_z);
     if (s_vert > 0.0 && std::isfinite(s_vert)) {
       prior.vertical_gamma = travel_y_.beta();

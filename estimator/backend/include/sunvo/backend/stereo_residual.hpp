@@ -146,11 +146,12 @@ class MotionPriorResidual {
     for (int i = 0; i < 3; ++i) {
       residual[3 + i] = T(prior_->sqrt_info_trans) * (t_rel[i] - T(prior_->t_pred[i]));
     }
-    const T psi = (q_rel.w() < T(0.0) ? T(-2.0) : T(2.0)) * q_rel.y();
+    const T two_sign = q_rel.w() < T(0.0) ? T(-2.0) : T(2.0);
+    const T psi = two_sign * q_rel.y();
     residual[6] =
         T(prior_->sqrt_info_lateral) * (t_rel[0] - T(prior_->lateral_beta) * t_rel[2] -
                                         psi * (T(0.5) * t_rel[2] + T(prior_->lateral_lever_m)));
-    const T theta = (q_rel.w() < T(0.0) ? T(-2.0) : T(2.0)) * q_rel.x();
+    const T theta = two_sign * q_rel.x();
     residual[7] = T(prior_->sqrt_info_vertical) *
                   (t_rel[1] - T(prior_->vertical_gamma) * t_rel[2] + T(0.5) * theta * t_rel[2]);
     return true;
