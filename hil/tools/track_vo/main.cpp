@@ -97,15 +97,18 @@ int main(int argc, char** argv) {
   std::printf(
       "options: window %d%s, ransac thr %.2f px iters %d min_inliers %d, sigma u/v/d "
       "%.2f/%.2f/%.2f px, loss %s scale %.2f, solver max_iter %d max_time %.3f s, "
-      "min_disparity %.2f px, motion prior %.3f deg / %.3f m, rate prior %s (pitch/yaw/roll "
-      "%.2f/%.2f/%.2f deg/s, adapted over %d frames), seed %llu\n",
+      "min_disparity %.2f px, motion prior %.3f deg / %.3f m / %.2f m/s^2, rate prior %s "
+      "(pitch/yaw/roll %.2f/%.2f/%.2f deg/s, adapted over %d frames), non-holonomic rows "
+      "lateral %.3f m/s (lever %.2f m, near %.1f m) vertical %.3f m/s (near %.1f m), seed %llu\n",
       win.window_size, opt.use_window ? "" : " (disabled)", opt.ransac.inlier_threshold_px,
       opt.ransac.max_iterations, opt.ransac.min_inliers, win.sigma_u_px, win.sigma_v_px,
       win.sigma_d_px, kLoss[static_cast<int>(win.loss)], win.loss_scale, win.max_num_iterations,
       win.max_solver_time_in_seconds, opt.ransac.min_disparity_px, win.motion_prior_sigma_rot_deg,
-      win.motion_prior_sigma_trans_m, win.rotation_rate_prior ? "on" : "off",
-      win.rate_prior_pitch_deg_s, win.rate_prior_yaw_deg_s, win.rate_prior_roll_deg_s,
-      win.rate_prior_adapt_frames, static_cast<unsigned long long>(opt.seed));
+      win.motion_prior_sigma_trans_m, win.motion_prior_sigma_accel_m_s2,
+      win.rotation_rate_prior ? "on" : "off", win.rate_prior_pitch_deg_s, win.rate_prior_yaw_deg_s,
+      win.rate_prior_roll_deg_s, win.rate_prior_adapt_frames, win.lateral_prior_sigma_m_s,
+      win.lateral_lever_m, win.lateral_prior_near_m, win.vertical_prior_sigma_m_s,
+      win.vertical_prior_near_m, static_cast<unsigned long long>(opt.seed));
   auto seq = sunvo::dataset::readTrackFolder(args.folder, sunvo::files::TrackReadOptions{});
   if (!seq) return sunvo::cli::fail(kProgram, seq.status());
   std::printf(
