@@ -106,8 +106,9 @@ struct WindowOptions {
   //   hypot(vertical_prior_sigma_m_s dt, |t_z| mount_sigma)
   // (its own vertical velocity against the body: suspension, bumps; the mount as above). gamma,
   // the camera's pitch against the direction of travel, is learnt like beta over the last
-  // vertical_gamma_frames steps (0 = gamma stays 0). Off for a vehicle that leaves the ground.
-  double vertical_prior_sigma_m_s = 0.0;  // m/s, [0, 100]: 0 = off
+  // vertical_gamma_frames steps (0 = gamma stays 0). On by default for a wheeled vehicle (with
+  // vertical_prior_near_m, docs/lateral_prior.md); set 0 for a vehicle that leaves the ground.
+  double vertical_prior_sigma_m_s = 0.1;  // m/s, [0, 100]: 0 = off
   int vertical_gamma_frames = 200;        // steps, [0, TravelDirection::kMaxFrames]
   // As lateral_prior_near_m, for the vertical step against the pitch.
   double vertical_prior_near_m = 8.0;  // m, [0, 1000]: 0 = the row on every frame
