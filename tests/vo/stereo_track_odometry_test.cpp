@@ -271,8 +271,9 @@ TEST(VoOptions, ValidateNamesTheBadKey) {
 // (frame 1 and the 5-match frames 53-54); without it (window.rotation_rate_prior = false) 2.106 m,
 // 10.19 m, 6.09 deg. With the step prior as well (default since 2026-11-30): 0.923 m, 4.027 m,
 // 2.830 deg; its prediction scaled by the frame interval: 0.920 m, 4.024 m, 2.830 deg. With the
-// vertical non-holonomic row (default since session 40): 0.497 m, 1.361 m, 2.336 deg. Bounds are
-// the measurement plus about 20 %.
+// vertical non-holonomic row (default since session 40), which waits for its slope to be learnt
+// (the first 16 steps): 0.834 m, 3.398 m, 2.704 deg. Bounds are the measurement plus about
+// 20 %.
 TEST(StereoTrackOdometry, ReplayRegressionOnReal0020Tracks) {
   const std::string dir = std::string(SUNVO_DATA_DIR) + "/kitti_tracks/2011_09_30_drive_0020";
   auto seq = files::readTrackFolder(dir, files::TrackReadOptions{});
@@ -299,9 +300,9 @@ TEST(StereoTrackOdometry, ReplayRegressionOnReal0020Tracks) {
       "replay 0020, 200 frames: ARMSE %.3f m, final drift %.3f m, rotation %.3f deg, "
       "lost %d\n",
       armse, drift, rot, lost);
-  EXPECT_LT(armse, 0.6);
-  EXPECT_LT(drift, 1.65);
-  EXPECT_LT(rot, 2.8);
+  EXPECT_LT(armse, 1.0);
+  EXPECT_LT(drift, 4.1);
+  EXPECT_LT(rot, 3.25);
   EXPECT_LE(lost, 3);
 }
 

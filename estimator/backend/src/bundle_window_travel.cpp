@@ -1,7 +1,7 @@
 // The window's non-holonomic rows (WindowOptions::lateral_prior_sigma_m_s and
-// vertical_prior_sigma_m_s; MotionPriorResidual; docs/lateral_prior.md): their per-frame stds and
-// the directions of travel they are built around, learnt from the solved steps. Part of
-// BundleWindow, kept apart from bundle_window.cpp by topic.
+// vertical_prior_sigma_m_s; MotionPriorResidual; docs/lateral_prior.md, docs/vertical_prior.md):
+// their per-frame stds and the directions of travel they are built around, learnt from the solved
+// steps. Part of BundleWindow, kept apart from bundle_window.cpp by topic.
 #include <algorithm>
 #include <cmath>
 
@@ -32,8 +32,15 @@ bool BundleWindow::setTravelRows(double dt_s, const Isometry3& T_k_km1_guess,
   const auto noneNearer = [&](double near_m) {
     return near_m <= 0.0 || d_max * near_m <= model_.fu * model_.baseline_m;
   };
+  // A row whose slope is learnt stays out until the slope is (TravelDirection::ready): held to a
+  // slope of 0 meanwhile, a camera pitched or turned against the travel would have its steps
+  // pulled towards 0, and those steps are the samples the slope is learnt from.
+  const auto slopeKnown = [](const TravelDirection& slope, int frames) {
+    return frames <= 0 || slope.ready();
+  };
   bool any = false;
-  if (lateral_on && noneNearer(options_.lateral_prior_near_m)) {
+  if (lateral_on && slopeKnown(travel_x_, options_.lateral_beta_frames) &&
+      noneNearer(options_.lateral_prior_near_m)) {
     const double s_lat =
         std::hypot(options_.lateral_prior_sigma_m_s * dt_s, mount_rad * t_z,
                    options_.lateral_lever_sigma_m * logSO3(T_k_km1_guess.linear()).y());
@@ -44,7 +51,8 @@ bool BundleWindow::setTravelRows(double dt_s, const Isometry3& T_k_km1_guess,
       any = true;
     }
   }
-  if (vertical_on && noneNearer(options_.vertical_prior_near_m)) {
+  if (vertical_on && slopeKnown(travel_y_, options_.vertical_gamma_frames) &&
+      noneNearer(options_.vertical_prior_near_m)) {
     const double s_vert = std::hypot(options_.vertical_prior_sigma_m_s * dt_s, mount_rad * t_z);
     if (s_vert > 0.0 && std::isfinite(s_vert)) {
       prior.vertical_gamma = travel_y_.beta();

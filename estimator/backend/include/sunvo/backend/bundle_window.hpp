@@ -100,14 +100,17 @@ struct WindowOptions {
   // The direction of travel beta (the row's t_z slope, TravelDirection) as the median over the
   // last N solved steps long enough for the mount angle to show above the sideways velocity
   // (|t_z| >= lateral_prior_sigma_m_s dt / tan(lateral_mount_sigma_deg)); 0 = beta stays 0.
+  // The row waits until beta is learnt (TravelDirection::ready(): 16 samples), so that the steps it
+  // is learnt from are not pulled towards a slope of 0.
   int lateral_beta_frames = 200;  // steps, [0, TravelDirection::kMaxFrames]
   // The same prior in the camera's vertical plane (MotionPriorResidual's vertical row): a vehicle
   // on the road steps along its body axis as it pitches, t_y = gamma t_z - theta t_z / 2, with std
   //   hypot(vertical_prior_sigma_m_s dt, |t_z| mount_sigma)
   // (its own vertical velocity against the body: suspension, bumps; the mount as above). gamma,
   // the camera's pitch against the direction of travel, is learnt like beta over the last
-  // vertical_gamma_frames steps (0 = gamma stays 0). On by default for a wheeled vehicle (with
-  // vertical_prior_near_m, docs/lateral_prior.md); set 0 for a vehicle that leaves the ground.
+  // vertical_gamma_frames steps (0 = gamma stays 0; the row waits for it as for beta). On by
+  // default for a wheeled vehicle (with vertical_prior_near_m, docs/vertical_prior.md); set 0 for a
+  // vehicle that leaves the ground.
   double vertical_prior_sigma_m_s = 0.1;  // m/s, [0, 100]: 0 = off
   int vertical_gamma_frames = 200;        // steps, [0, TravelDirection::kMaxFrames]
   // As lateral_prior_near_m, for the vertical step against the pitch.

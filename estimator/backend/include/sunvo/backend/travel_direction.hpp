@@ -28,9 +28,11 @@ class TravelDirection : private SampleRing<1, kTravelDirectionMaxFrames> {
 
  public:
   static constexpr int kMaxFrames = kTravelDirectionMaxFrames;
-  // Fewer samples than this and than a quarter of the capacity leave beta() at 0 (a ring smaller
-  // than this is ready when full).
-  static constexpr int kMinSamples = 8;
+  // Fewer samples than this leave beta() at 0 (a ring smaller than this is ready when full). On the
+  // real 0020 tracks the medians of 16 consecutive steps scatter by 10 (vertical) and 18 mrad
+  // (sideways) about the drive's, inside the 35 mrad (2 deg) a row's mount std allows; the rows
+  // wait for it (WindowOptions::lateral_beta_frames). Chosen on the validation sets over 8 and 50.
+  static constexpr int kMinSamples = 16;
 
   // frames: samples kept, [0, kMaxFrames] (setCapacity clamps and clears); 0 keeps nothing.
   explicit TravelDirection(int frames = 0) { setCapacity(frames); }
@@ -40,10 +42,8 @@ class TravelDirection : private SampleRing<1, kTravelDirectionMaxFrames> {
   // beta_rad: one step's direction of travel, x over z in the camera frame. A non-finite sample
   // is ignored (returns false).
   bool push(double beta_rad) { return Ring::push({beta_rad}); }
-  // Whether enough samples are kept: max(kMinSamples, capacity / 4), or a full ring.
-  bool ready() const {
-    return capacity() > 0 && size() >= std::min(capacity(), std::max(kMinSamples, capacity() / 4));
-  }
+  // Whether enough samples are kept: kMinSamples, or a full ring.
+  bool ready() const { return capacity() > 0 && size() >= std::min(capacity(), kMinSamples); }
   // The median of the kept samples, rad; 0 while not ready().
   double beta() const { return ready() ? median(0) : 0.0; }
 };
