@@ -151,9 +151,8 @@ def main():
                 f, sx, sy, sz = numbers(sun_path, i, text, ("frame", "sx", "sy", "sz"))
                 s2 = mat_vec(R, [sx, sy, sz])
                 o.write(f"{int(f)},{s2[0]:.9f},{s2[1]:.9f},{s2[2]:.9f}\n")
-    for name in ("times.txt",):
-        if os.path.isfile(os.path.join(src, name)):
-            shutil.copy(os.path.join(src, name), os.path.join(args.out, name))
+    if os.path.isfile(os.path.join(src, "times.txt")):
+        shutil.copy(os.path.join(src, "times.txt"), os.path.join(args.out, "times.txt"))
     print(f"turn_rig_tracks.py: {len(rows)} observations turned by {args.deg:g} deg about "
           f"{args.axis}; left out: {no_depth} without a positive disparity, {behind} nearer than 1 m; "
           f"image {width}x{height}, "

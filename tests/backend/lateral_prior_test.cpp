@@ -145,17 +145,18 @@ Eigen::Vector3d solvePair(BundleWindow& w, bool one_sided, const Isometry3& T_k_
   return logSO3(w.T_k_b(1).linear() * T_k_km1.linear().transpose());
 }
 
-// What the window w (initialised) learns of a slope (read by slope) from 100 well-tracked steps
-// over step, and the mean rotation error about axis (0 pitch, 1 yaw) of the 40 one-sided frames
-// solved over the same step after them, rad.
+// What the window w (initialised) learns of a slope (read by slope) from 100 steps over step
+// (well tracked, or one-sided with learn_one_sided), and the mean rotation error about axis (0
+// pitch, 1 yaw) of the 40 one-sided frames solved over the same step after them, rad.
 struct LearntSlope {
   double slope;
   double one_sided_bias;
 };
 LearntSlope learnThenSolveOneSided(BundleWindow& w, double (BundleWindow::*slope)() const,
-                                   const Isometry3& step, int axis, std::uint64_t seed) {
+                                   const Isometry3& step, int axis, std::uint64_t seed,
+                                   bool learn_one_sided = false) {
   std::mt19937_64 rng(seed);
-  for (int k = 0; k < 100; ++k) solvePair(w, false, step, rng);
+  for (int k = 0; k < 100; ++k) solvePair(w, learn_one_sided, step, rng);
   LearntSlope out{(w.*slope)(), 0.0};
   const int draws = 40;
   for (int k = 0; k < draws; ++k) out.one_sided_bias += solvePair(w, true, step, rng)[axis] / draws;
@@ -276,17 +277,12 @@ TEST(VerticalPrior, LearnsALargePitchBeforeTheRowActs) {
   wo.vertical_gamma_frames = 100;
   BundleWindow w;
   ASSERT_TRUE(w.init(wo, kittiCamera()).isOk());
-  std::mt19937_64 rng(17);
-  const Isometry3 step = crestStep(1.2, 0.0, gamma);
-  for (int k = 0; k < 100; ++k) solvePair(w, true, step, rng);
-  const double slope = w.verticalGamma();
-  double bias = 0.0;
-  const int draws = 40;
-  for (int k = 0; k < draws; ++k) bias += solvePair(w, true, step, rng).x() / draws;
+  const LearntSlope r = learnThenSolveOneSided(w, &BundleWindow::verticalGamma,
+                                               crestStep(1.2, 0.0, gamma), 0, 17, true);
   std::printf("10 deg camera pitch: gamma learnt %.1f mrad (tan %.1f), mean pitch error %.4f deg\n",
-              1e3 * slope, 1e3 * std::tan(gamma), bias * 180.0 / M_PI);
-  EXPECT_NEAR(slope, std::tan(gamma), 6e-3);
-  EXPECT_LT(std::abs(bias) * 180.0 / M_PI, 0.1);
+              1e3 * r.slope, 1e3 * std::tan(gamma), r.one_sided_bias * 180.0 / M_PI);
+  EXPECT_NEAR(r.slope, std::tan(gamma), 6e-3);
+  EXPECT_LT(std::abs(r.one_sided_bias) * 180.0 / M_PI, 0.1);
 }
 
 // The conditioning rule (WindowOptions::vertical_prior_near_m): a frame with a track nearer than

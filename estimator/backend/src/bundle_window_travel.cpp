@@ -32,15 +32,15 @@ bool BundleWindow::setTravelRows(double dt_s, const Isometry3& T_k_km1_guess,
   const auto noneNearer = [&](double near_m) {
     return near_m <= 0.0 || d_max * near_m <= model_.fu * model_.baseline_m;
   };
-  // A row whose slope is learnt stays out until the slope is (TravelDirection::ready): held to a
-  // slope of 0 meanwhile, a camera pitched or turned against the travel would have its steps
-  // pulled towards 0, and those steps are the samples the slope is learnt from.
-  const auto slopeKnown = [](const TravelDirection& slope, int frames) {
-    return frames <= 0 || slope.ready();
+  // A row whose slope is learnt (a ring with capacity, from *_frames) stays out until the slope
+  // is (TravelDirection::ready): held to a slope of 0 meanwhile, a camera pitched or turned
+  // against the travel would have its steps pulled towards 0, and those steps are the samples the
+  // slope is learnt from. Without a ring the slope is 0 by choice and the row acts at once.
+  const auto slopeKnown = [](const TravelDirection& slope) {
+    return slope.capacity() == 0 || slope.ready();
   };
   bool any = false;
-  if (lateral_on && slopeKnown(travel_x_, options_.lateral_beta_frames) &&
-      noneNearer(options_.lateral_prior_near_m)) {
+  if (lateral_on && slopeKnown(travel_x_) && noneNearer(options_.lateral_prior_near_m)) {
     const double s_lat =
         std::hypot(options_.lateral_prior_sigma_m_s * dt_s, mount_rad * t_z,
                    options_.lateral_lever_sigma_m * logSO3(T_k_km1_guess.linear()).y());
@@ -51,8 +51,7 @@ bool BundleWindow::setTravelRows(double dt_s, const Isometry3& T_k_km1_guess,
       any = true;
     }
   }
-  if (vertical_on && slopeKnown(travel_y_, options_.vertical_gamma_frames) &&
-      noneNearer(options_.vertical_prior_near_m)) {
+  if (vertical_on && slopeKnown(travel_y_) && noneNearer(options_.vertical_prior_near_m)) {
     const double s_vert = std::hypot(options_.vertical_prior_sigma_m_s * dt_s, mount_rad * t_z);
     if (s_vert > 0.0 && std::isfinite(s_vert)) {
       prior.vertical_gamma = travel_y_.beta();
