@@ -45,7 +45,10 @@ int main(int argc, char** argv) {
   options.use_sun = false;
   sunvo::vo::VoOptions& opt = options.pipeline.vo;
   sunvo::backend::WindowOptions& win = opt.window;
-  CLI::App app{"Pure stereo VO over a feature-track folder; KITTI and TUM poses out.", kProgram};
+  CLI::App app{
+      "Pure stereo VO over a feature-track folder; KITTI and TUM poses out. VO assumes the KITTI "
+      "car (the sideways non-holonomic row with a 0.88 m lever arm; --lateral-prior 0 for none).",
+      kProgram};
   app.add_option("track_folder", args.folder, "tracks.csv, calib.txt, times.txt[, gt_poses.txt]")
       ->required()
       ->check(CLI::ExistingDirectory);
@@ -70,6 +73,7 @@ int main(int argc, char** argv) {
   double min_disparity = opt.ransac.min_disparity_px;
   app.add_option("--min-disparity", min_disparity, "smallest disparity used, px");
   app.add_option("--seed", opt.seed, "RANSAC seed");
+  sunvo::cli::setKittiCarVehicle(win);  // the KITTI car's lever arm (cli.hpp)
   sunvo::cli::addWindowPriorOptions(app, win);
   app.add_option("--log", args.log_path, "per-frame CSV log");
   sunvo::selfcal::StereoSelfCalibrationOptions selfcal_opt;  // issue 15: off unless --self-calib
@@ -99,7 +103,8 @@ int main(int argc, char** argv) {
       "%.2f/%.2f/%.2f px, loss %s scale %.2f, solver max_iter %d max_time %.3f s, "
       "min_disparity %.2f px, motion prior %.3f deg / %.3f m / %.2f m/s^2, rate prior %s "
       "(pitch/yaw/roll %.2f/%.2f/%.2f deg/s, adapted over %d frames), non-holonomic rows "
-      "lateral %.3f m/s (lever %.2f m, near %.1f m) vertical %.3f m/s (near %.1f m), seed %llu\n",
+      "lateral %.3f m/s (lever %.2f m, near %.1f m) vertical %.3f m/s (near %.1f m), mount "
+      "%.2f deg, seed %llu\n",
       win.window_size, opt.use_window ? "" : " (disabled)", opt.ransac.inlier_threshold_px,
       opt.ransac.max_iterations, opt.ransac.min_inliers, win.sigma_u_px, win.sigma_v_px,
       win.sigma_d_px, kLoss[static_cast<int>(win.loss)], win.loss_scale, win.max_num_iterations,
@@ -108,7 +113,8 @@ int main(int argc, char** argv) {
       win.rotation_rate_prior ? "on" : "off", win.rate_prior_pitch_deg_s, win.rate_prior_yaw_deg_s,
       win.rate_prior_roll_deg_s, win.rate_prior_adapt_frames, win.lateral_prior_sigma_m_s,
       win.lateral_lever_m, win.lateral_prior_near_m, win.vertical_prior_sigma_m_s,
-      win.vertical_prior_near_m, static_cast<unsigned long long>(opt.seed));
+      win.vertical_prior_near_m, win.lateral_mount_sigma_deg,
+      static_cast<unsigned long long>(opt.seed));
   auto seq = sunvo::dataset::readTrackFolder(args.folder, sunvo::files::TrackReadOptions{});
   if (!seq) return sunvo::cli::fail(kProgram, seq.status());
   std::printf(
