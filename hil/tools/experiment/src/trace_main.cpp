@@ -191,6 +191,10 @@ int main(int argc, char** argv) {
   bool fixed_drift = false, evidence = false;
   CLI::App app{"Traces the sun fusion's gate, covariance and corrections against ground truth.",
                kProgram};
+  // The same VO as sunvo_experiment: the KITTI car's sideways row and the window's prior options.
+  sunvo::experiment::ExperimentOptions options;
+  sunvo::cli::setKittiCarVehicle(options.vo.window);  // the KITTI car's lever arm (cli.hpp)
+  sunvo::cli::addWindowPriorOptions(app, options.vo.window);
   app.add_option("--data", data_dir, "folder of the real data (shared/data layout)");
   app.add_option("--out", out_dir, "output folder for the per-frame CSV files (created)");
   app.add_option("--routes", routes_arg, "comma-separated routes, as sunvo_experiment");
@@ -223,7 +227,6 @@ int main(int argc, char** argv) {
   std::error_code ec;
   std::filesystem::create_directories(out_dir, ec);
   if (ec) return sunvo::cli::fail(kProgram, "cannot create '" + out_dir + "': " + ec.message());
-  sunvo::experiment::ExperimentOptions options;
   options.max_frames = frames;
   options.vo.window.max_solver_time_in_seconds = 60.0;
   if (drift_deg) options.fusion.attitude_drift_deg_per_frame = *drift_deg;
