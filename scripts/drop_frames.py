@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""A track folder with frames left out, numbered on without a gap: a camera that drops frames.
+"""A track folder with frames left out, numbered on without a gap: a camera that drops frames,
+or a stretch of a route as a route of its own.
 
 KITTI raw and odometry data number their frames consecutively; where the recorder lost a frame
 only the timestamp jumps. A camera driver that loses a buffer under load does the same to a
@@ -7,8 +8,12 @@ rover's log. This makes such a folder from a real one (docs/motion_prior.md, "Dr
 each frame after the first is left out with probability DROP drawn from SEED, or every N-th frame
 with --every N. tracks.csv, times.txt, gt_poses.txt and sun_cam.csv keep the rows of the kept
 frames and are numbered 0, 1, 2, ... again; calib.txt is copied.
+--range FIRST COUNT keeps frames FIRST .. FIRST+COUNT-1 only: a short route that starts anywhere
+(in a turn, with the rig's error already there; docs/sparse_tracks.md, "Short routes"). Its ground
+truth is re-expressed in the first kept frame's camera (T_0_k = T_w_first^-1 T_w_k), so it starts
+at the identity like any KITTI pose file.
 No dependencies beyond Python.
-Usage: drop_frames.py TRACKS OUT (--drop DROP [--seed SEED] | --every N)
+Usage: drop_frames.py TRACKS OUT (--drop DROP [--seed SEED] | --every N | --range FIRST COUNT)
 """
 import argparse
 import os
@@ -45,6 +50,22 @@ def renumber_csv(src, dst, new_index, what):
                 out.write(f"{new_index[k]},{rest}\n")
 
 
+def relative_pose(first, pose, where):
+    """T_first^-1 T for 3x4 row-major KITTI poses (12 numbers each), as a pose line."""
+    try:
+        a, b = [float(x) for x in first.split()], [float(x) for x in pose.split()]
+    except ValueError:
+        fail(f"{where}: not a number")
+    if len(a) != 12 or len(b) != 12:
+        fail(f"{where}: expected 12 numbers")
+    out = []
+    for i in range(3):
+        for j in range(3):  # (R_first^T R)_ij
+            out.append(sum(a[4 * k + i] * b[4 * k + j] for k in range(3)))
+        out.append(sum(a[4 * k + i] * (b[4 * k + 3] - a[4 * k + 3]) for k in range(3)))
+    return " ".join(f"{x:.9e}" for x in out)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("tracks", help="track folder")
@@ -52,6 +73,8 @@ def main():
     how = ap.add_mutually_exclusive_group(required=True)
     how.add_argument("--drop", type=float, help="share of frames left out, [0, 1)")
     how.add_argument("--every", type=int, help="leave out every N-th frame, N >= 2")
+    how.add_argument("--range", type=int, nargs=2, metavar=("FIRST", "COUNT"),
+                     help="keep frames FIRST .. FIRST+COUNT-1 only, COUNT >= 2")
     ap.add_argument("--seed", type=int, default=1, help="seed of the draw (with --drop)")
     a = ap.parse_args()
     if a.drop is not None and not 0.0 <= a.drop < 1.0:
@@ -65,7 +88,12 @@ def main():
     times = read_lines(times_path)
     n = len(times)
     rng = random.Random(a.seed)
-    if a.every is not None:
+    if a.range is not None:
+        first, count = a.range
+        if first < 0 or count < 2 or first + count > n:
+            fail(f"--range {first} {count}: outside the {n} frames of {times_path}")
+        keep = [first <= k < first + count for k in range(n)]
+    elif a.every is not None:
         keep = [k == 0 or (k + 1) % a.every != 0 for k in range(n)]
     else:
         keep = [k == 0 or rng.random() >= a.drop for k in range(n)]
@@ -82,8 +110,13 @@ def main():
         poses = read_lines(gt)
         if len(poses) != n:
             fail(f"{gt}: {len(poses)} poses, but times.txt has {n} frames")
+        kept_poses = [p for p, k in zip(poses, keep) if k]
+        if not keep[0]:  # a stretch: the first kept frame becomes the origin
+            first_line = keep.index(True) + 1
+            kept_poses = [relative_pose(kept_poses[0], p, f"{gt}:{first_line + i}")
+                          for i, p in enumerate(kept_poses)]
         with open(os.path.join(a.out, "gt_poses.txt"), "w") as f:
-            f.writelines(p + "\n" for p, k in zip(poses, keep) if k)
+            f.writelines(p + "\n" for p in kept_poses)
     renumber_csv(os.path.join(a.tracks, "tracks.csv"), os.path.join(a.out, "tracks.csv"),
                  new_index, "landmark,uL,vL,uR,vR")
     sun = os.path.join(a.tracks, "sun_cam.csv")

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Tests of scripts/drop_frames.py: the kept frames are numbered on without a gap in every file,
-their times, poses and sun rows are the originals', the draw repeats for a seed, and bad input
-names the file and line."""
+their times, poses and sun rows are the originals', the draw repeats for a seed, a stretch
+(--range) starts its ground truth at the identity, and bad input names the file and line."""
 import os
 import subprocess
 import sys
@@ -76,6 +76,36 @@ class DropFrames(unittest.TestCase):
             self.assertLess(len(runs["a"]), FRAMES)
             self.assertEqual(runs["a"], runs["b"])
             self.assertNotEqual(runs["a"], runs["c"])
+
+    def test_a_stretch_starts_at_the_identity(self):
+        with tempfile.TemporaryDirectory() as d:
+            src, out = os.path.join(d, "src"), os.path.join(d, "out")
+            self.write_folder(src)
+            # The poses turn 90 deg about y per frame pair from frame 10 on: R(k) = Ry(90 (k >= 10)),
+            # t = (k, 0, 0); frames 12..17 kept.
+            rot = "0 0 1 {k} 0 1 0 0 -1 0 0 0\n"
+            with open(os.path.join(src, "gt_poses.txt"), "w") as f:
+                f.write("".join(rot.format(k=k) if k >= 10 else f"1 0 0 {k} 0 1 0 0 0 0 1 0\n"
+                                for k in range(FRAMES)))
+            r = self.run_script(src, out, "--range", "12", "6")
+            self.assertEqual(r.returncode, 0, r.stderr)
+            times = [round(float(t) * 10) for t in self.read(out, "times.txt")]
+            self.assertEqual(times, list(range(12, 18)))
+            poses = [[float(x) for x in p.split()] for p in self.read(out, "gt_poses.txt")]
+            self.assertEqual(len(poses), 6)
+            for i, p in enumerate(poses):
+                # R_first^T R = I; R_first^T (t - t_first) = Ry(90)^T (i, 0, 0) = (0, 0, i).
+                expected = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, i]
+                for got, want in zip(p, expected):
+                    self.assertAlmostEqual(got, want, places=9)
+            tracks = [r.split(",") for r in self.read(out, "tracks.csv")[1:]]
+            self.assertEqual(sorted({int(t[0]) for t in tracks}), list(range(6)))
+            self.assertEqual({int(t[2]) - 100 - int(t[0]) for t in tracks}, {12})
+            sun = self.read(out, "sun_cam.csv")
+            self.assertEqual([int(r.split(",")[1]) for r in sun[1:]], list(range(12, 18)))
+            r = self.run_script(src, os.path.join(d, "out2"), "--range", "38", "3")
+            self.assertNotEqual(r.returncode, 0)
+            self.assertIn("--range 38 3", r.stderr)
 
     def test_bad_input_names_the_file(self):
         with tempfile.TemporaryDirectory() as d:
