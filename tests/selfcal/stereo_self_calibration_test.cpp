@@ -186,6 +186,53 @@ TEST(StereoSelfCalibration, OffPassesThroughAndOptionsAreChecked) {
   EXPECT_EQ(cal.init(bad, camera()).message(), "self_calibration.gate_px outside (0, 50] px");
 }
 
+// An entered disparity bias a (d_measured = d + a) is taken out of every uR, with the estimation
+// off and on; with it on, the rows still give the roll, and the bias does not reach them.
+TEST(StereoSelfCalibration, TakesOutAnEnteredDisparityBias) {
+  constexpr double kBias = -0.37;  // px: 0020's, docs/disparity_bias.md
+  const auto clean = tracks(120, 0.0);
+  auto biased = clean;
+  miscalibrate(biased, 0.0, 0.08 * kDeg);
+  for (FrameFeatures& f : biased) {
+    for (StereoObservation& o : f.observations) o.u_right -= kBias;  // uL - uR grows by a
+  }
+  StereoSelfCalibrationOptions off;
+  off.disparity_bias_px = kBias;
+  StereoSelfCalibrationOptions est = on();
+  est.disparity_bias_px = kBias;
+  StereoSelfCalibration cal_off, cal_on, plain;
+  ASSERT_TRUE(cal_off.init(off, camera()).isOk());
+  ASSERT_TRUE(cal_on.init(est, camera()).isOk());
+  ASSERT_TRUE(plain.init(StereoSelfCalibrationOptions{}, camera()).isOk());
+  EXPECT_TRUE(cal_off.active());
+  EXPECT_FALSE(cal_off.enabled());
+  EXPECT_FALSE(plain.active());
+  FrameFeatures out_off, out_on;
+  SelfCalibrationReport r;
+  double worst_on = 0.0;
+  for (std::size_t k = 0; k < clean.size(); ++k) {
+    cal_off.process(biased[k], &out_off);
+    r = cal_on.process(biased[k], &out_on);
+    ASSERT_EQ(out_off.observations.size(), clean[k].observations.size());
+    ASSERT_EQ(out_on.observations.size(), clean[k].observations.size());
+    for (std::size_t i = 0; i < clean[k].observations.size(); ++i) {
+      EXPECT_NEAR(out_off.observations[i].u_right, biased[k].observations[i].u_right + kBias,
+                  1e-12);
+      EXPECT_DOUBLE_EQ(out_off.observations[i].v_right, biased[k].observations[i].v_right);
+      if (k >= 100) {  // converged: the roll out too
+        worst_on = std::max(
+            worst_on, std::abs(out_on.observations[i].u_right - clean[k].observations[i].u_right));
+      }
+    }
+  }
+  EXPECT_NEAR(r.roll_mrad, 0.08 * kDeg * 1e3, 0.01);
+  EXPECT_LT(worst_on, 0.005);
+  StereoSelfCalibrationOptions bad;
+  bad.disparity_bias_px = 6.0;
+  EXPECT_EQ(plain.init(bad, camera()).message(),
+            "self_calibration.disparity_bias_px outside [-5, 5] px");
+}
+
 TEST(StereoSelfCalibration, ReportCsvRowMatchesItsHeader) {
   SelfCalibrationReport r;
   r.pitch_mrad = -0.15112;

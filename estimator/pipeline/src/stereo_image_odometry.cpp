@@ -111,7 +111,7 @@ Expected<FrameResult> StereoImageOdometry::process(const StereoFrame& frame) {
   // The self-calibration learns the right camera's turn from this frame's rows and corrects
   // the right observations before the back end sees them.
   const FrameFeatures* to_odometry = &features_;
-  if (self_calibration_.enabled()) {
+  if (self_calibration_.active()) {
     r.self_calibration = self_calibration_.process(features_, &corrected_);
     to_odometry = &corrected_;
   }

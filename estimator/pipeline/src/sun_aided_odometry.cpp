@@ -118,7 +118,7 @@ Expected<vo::VoResult> SunAidedOdometry::process(const FrameFeatures& frame) {
   }
   levelStartIfDue(frame.sequence);
   const FrameFeatures* in = &frame;
-  if (selfcal_.enabled()) {
+  if (selfcal_.active()) {
     const auto t0 = std::chrono::steady_clock::now();
     selfcal_report_ = selfcal_.process(frame, &corrected_);
     in = &corrected_;

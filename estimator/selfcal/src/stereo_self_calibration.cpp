@@ -18,6 +18,7 @@ Status StereoSelfCalibrationOptions::validate() const {
   auto bad = [&](const char* key, const char* range) {
     return invalidArgument(std::string(p) + key + " outside " + range);
   };
+  if (!inRange(disparity_bias_px, -5.0, 5.0)) return bad("disparity_bias_px", "[-5, 5] px");
   if (!(sigma_px > 0.0 && sigma_px <= 10.0)) return bad("sigma_px", "(0, 10] px");
   if (!(gate_px > 0.0 && gate_px <= 50.0)) return bad("gate_px", "(0, 50] px");
   if (!(prior_sigma_deg > 0.0 && prior_sigma_deg <= 10.0)) {
@@ -76,6 +77,11 @@ SelfCalibrationReport StereoSelfCalibration::process(const FrameFeatures& in, Fr
   out->time_ns = in.time_ns;
   out->sequence = in.sequence;
   out->observations.assign(in.observations.begin(), in.observations.end());
+  // The entered disparity bias: d = uL - uR - a, so uR + a (the estimation below reads only rows).
+  const double bias = options_.disparity_bias_px;
+  if (bias != 0.0) {
+    for (StereoObservation& o : out->observations) o.u_right += bias;
+  }
   if (!options_.enabled) return r;
 
   // Predict: the angles follow their drift rate; random walks and the rates' forgetting.
@@ -118,13 +124,13 @@ SelfCalibrationReport StereoSelfCalibration::process(const FrameFeatures& in, Fr
     ++resets_;
     r.reset = true;
     r.resets = resets_;
-    return r;  // this frame goes on as measured
+    return r;  // this frame goes on as measured (less the entered bias)
   }
-  // Correct the right observations (the inverse of the model above).
+  // Correct the right observations (the inverse of the model above; the bias is already out).
   const double delta = x_[0], theta = x_[1], s = x_[2];
   for (StereoObservation& o : out->observations) {
-    const double u = o.u_right, v = o.v_right;
-    o.u_right = u + theta * (v - cv);
+    const double u = o.u_right - bias, v = o.v_right;
+    o.u_right = u + theta * (v - cv) + bias;
     o.v_right = v - fv * delta - theta * (u - cu) - s * (v - cv);
   }
   r.pitch_mrad = delta * 1e3;

@@ -80,6 +80,7 @@ int main(int argc, char** argv) {
   app.add_flag("--self-calib", selfcal_opt.enabled,
                "online stereo self-calibration of the right camera before the odometry");
   sunvo::cli::addSelfCalibrationRateOptions(app, selfcal_opt);
+  sunvo::cli::addDisparityBiasOption(app, selfcal_opt);
   app.add_option("--self-calib-log", args.selfcal_log_path,
                  "per-frame CSV of the self-calibration (pitch, roll, scale, resets)");
   if (auto code = sunvo::cli::parse(app, argc, argv)) return *code;
@@ -104,7 +105,7 @@ int main(int argc, char** argv) {
       "min_disparity %.2f px, motion prior %.3f deg / %.3f m / %.2f m/s^2, rate prior %s "
       "(pitch/yaw/roll %.2f/%.2f/%.2f deg/s, adapted over %d frames), non-holonomic rows "
       "lateral %.3f m/s (lever %.2f m, near %.1f m) vertical %.3f m/s (near %.1f m), mount "
-      "%.2f deg, seed %llu\n",
+      "%.2f deg, disparity bias %.3f px, seed %llu\n",
       win.window_size, opt.use_window ? "" : " (disabled)", opt.ransac.inlier_threshold_px,
       opt.ransac.max_iterations, opt.ransac.min_inliers, win.sigma_u_px, win.sigma_v_px,
       win.sigma_d_px, kLoss[static_cast<int>(win.loss)], win.loss_scale, win.max_num_iterations,
@@ -113,7 +114,7 @@ int main(int argc, char** argv) {
       win.rotation_rate_prior ? "on" : "off", win.rate_prior_pitch_deg_s, win.rate_prior_yaw_deg_s,
       win.rate_prior_roll_deg_s, win.rate_prior_adapt_frames, win.lateral_prior_sigma_m_s,
       win.lateral_lever_m, win.lateral_prior_near_m, win.vertical_prior_sigma_m_s,
-      win.vertical_prior_near_m, win.lateral_mount_sigma_deg,
+      win.vertical_prior_near_m, win.lateral_mount_sigma_deg, selfcal_opt.disparity_bias_px,
       static_cast<unsigned long long>(opt.seed));
   auto seq = sunvo::dataset::readTrackFolder(args.folder, sunvo::files::TrackReadOptions{});
   if (!seq) return sunvo::cli::fail(kProgram, seq.status());

@@ -27,7 +27,11 @@
 // neither held either: the bias from the motion with the motion refitted per 8-frame segment is
 // right only to +-0.03 px over 150 frames and made every drive drift more (0.066 -> 0.358 m on a
 // calibrated one), and read -1.1 px on 0020; the rows' yaw term took 0.01-0.02 deg from the roll.
-// Not estimated: a rig's yaw needs an offline calibration (docs/selfcal.md).
+// Not estimated: a rig's yaw needs an offline calibration (docs/selfcal.md). Its disparity bias
+// a (d_measured = fu b / z + a, constant over a drive) is VO-invisible: the odometry's own poses
+// absorb it (docs/disparity_bias.md: 0020's tracks carry -0.37 px, read as 0 with VO's poses).
+// Measured offline (scripts/disparity_bias.py with poses of a known length), it is entered as
+// disparity_bias_px and taken out of every uR (uR + a), with or without the estimation.
 //
 // Drift model. A rig warms and cools over minutes, so its error changes as a ramp more than as a
 // random walk: a random walk small enough to stay quiet on a steady rig trails a ramp by
@@ -59,7 +63,11 @@
 namespace sunvo::selfcal {
 
 struct StereoSelfCalibrationOptions {
-  bool enabled = false;             // the switch; off: observations pass unchanged
+  bool enabled = false;  // the switch; off: observations pass unchanged (but for
+                         //   disparity_bias_px)
+  // The rig's constant disparity error, measured offline (see the header), taken out of every
+  // observation whether or not the estimation is enabled; 0 = none.
+  double disparity_bias_px = 0.0;   // px, [-5, 5]
   double sigma_px = 0.5;            // px, (0, 10]: vertical noise of one observation
   double gate_px = 1.5;             // px, (0, 50]: larger |y - H x| is not used
   double prior_sigma_deg = 0.1;     // deg, (0, 10]: prior of pitch and roll
@@ -79,6 +87,7 @@ struct StereoSelfCalibrationOptions {
   template <class Self, class V>
   static void fields(Self& s, V& v) {
     v("enabled", s.enabled);
+    v("disparity_bias_px", s.disparity_bias_px);
     v("sigma_px", s.sigma_px);
     v("gate_px", s.gate_px);
     v("prior_sigma_deg", s.prior_sigma_deg);
@@ -118,9 +127,12 @@ class StereoSelfCalibration {
  public:
   Status init(const StereoSelfCalibrationOptions& options, const StereoCamera& camera);
   bool enabled() const { return options_.enabled; }
+  // Whether process() changes anything: the estimation is on or a disparity bias is entered.
+  bool active() const { return options_.enabled || options_.disparity_bias_px != 0.0; }
 
   // Estimates from `in`, then writes `in` with corrected right observations to `out` (its vector
-  // is reused: no allocation once its capacity suffices). Disabled: out = in.
+  // is reused: no allocation once its capacity suffices). Disabled: out = in, less the entered
+  // disparity bias.
   SelfCalibrationReport process(const FrameFeatures& in, FrameFeatures* out);
 
   // (delta rad, theta rad, s, delta_dot rad/frame, theta_dot rad/frame)

@@ -237,4 +237,15 @@ void addSelfCalibrationRateOptions(CLI::App& app, SelfCalibrationOptions& sc) {
       ->check(CLI::Range(1.0, 1e7));
 }
 
+// The rig's constant disparity bias, measured offline (scripts/disparity_bias.py with poses of a
+// known length; docs/disparity_bias.md) and taken out of every observation, with or without the
+// self-calibration: --disparity-bias-px (selfcal::StereoSelfCalibrationOptions).
+template <class SelfCalibrationOptions>
+void addDisparityBiasOption(CLI::App& app, SelfCalibrationOptions& sc) {
+  app.add_option("--disparity-bias-px", sc.disparity_bias_px,
+                 "the rig's measured disparity bias, px: d - bias is used "
+                 "(self_calibration.disparity_bias_px; 0 = none)")
+      ->check(CLI::Range(-5.0, 5.0));
+}
+
 }  // namespace sunvo::cli
