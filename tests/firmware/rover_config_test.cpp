@@ -107,7 +107,17 @@ TEST(RoverConfig, DefaultsAndOverrides) {
   EXPECT_NE(text.find("  telemetry.frame: ardupilot\n"), std::string::npos);
   auto px4 = loadRoverConfig(path);
   ASSERT_TRUE(px4) << px4.status().toString();
-  EXPECT_EQ(px4->telemetry.frame, mavlink::FrameProfile::kPx4);  // the default
+  EXPECT_EQ(px4->telemetry.frame, mavlink::FrameProfile::kPx4);                // the default
+  EXPECT_EQ(px4->estimator.pipeline.self_calibration.disparity_bias_px, 0.0);  // none entered
+  // A rig's measured disparity bias (docs/disparity_bias.md), and one outside its range.
+  auto biased = loadRoverConfig(path, {{"estimator.self_calibration.disparity_bias_px", "-0.37"}});
+  ASSERT_TRUE(biased) << biased.status().toString();
+  EXPECT_DOUBLE_EQ(biased->estimator.pipeline.self_calibration.disparity_bias_px, -0.37);
+  auto too_big = loadRoverConfig(path, {{"estimator.self_calibration.disparity_bias_px", "7"}});
+  ASSERT_FALSE(too_big);
+  EXPECT_NE(too_big.status().message().find("self_calibration.disparity_bias_px"),
+            std::string::npos)
+      << too_big.status().message();
 }
 
 // The raw-calibration, colour and camera-mount keys (docs/deployment.md, "Stereo calibration"):
