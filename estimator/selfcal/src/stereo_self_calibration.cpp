@@ -129,8 +129,8 @@ SelfCalibrationReport StereoSelfCalibration::process(const FrameFeatures& in, Fr
   // Correct the right observations (the inverse of the model above; the bias is already out).
   const double delta = x_[0], theta = x_[1], s = x_[2];
   for (StereoObservation& o : out->observations) {
-    const double u = o.u_right - bias, v = o.v_right;
-    o.u_right = u + theta * (v - cv) + bias;
+    const double u = o.u_right - bias, v = o.v_right;  // uR as measured: the model's column
+    o.u_right += theta * (v - cv);
     o.v_right = v - fv * delta - theta * (u - cu) - s * (v - cv);
   }
   r.pitch_mrad = delta * 1e3;

@@ -79,8 +79,7 @@ int main(int argc, char** argv) {
   sunvo::selfcal::StereoSelfCalibrationOptions selfcal_opt;  // issue 15: off unless --self-calib
   app.add_flag("--self-calib", selfcal_opt.enabled,
                "online stereo self-calibration of the right camera before the odometry");
-  sunvo::cli::addSelfCalibrationRateOptions(app, selfcal_opt);
-  sunvo::cli::addDisparityBiasOption(app, selfcal_opt);
+  sunvo::cli::addSelfCalibrationOptions(app, selfcal_opt);
   app.add_option("--self-calib-log", args.selfcal_log_path,
                  "per-frame CSV of the self-calibration (pitch, roll, scale, resets)");
   if (auto code = sunvo::cli::parse(app, argc, argv)) return *code;

@@ -130,8 +130,7 @@ int main(int argc, char** argv) {
                                   level_start);
   app.add_flag("--self-calib", self_calib,
                "online stereo self-calibration of the right camera before the odometry");
-  sunvo::cli::addSelfCalibrationRateOptions(app, options.self_calibration);
-  sunvo::cli::addDisparityBiasOption(app, options.self_calibration);
+  sunvo::cli::addSelfCalibrationOptions(app, options.self_calibration);
   app.add_option("--drift-rule", drift_rule, "how the random walk adapts")
       ->check(CLI::IsMember({"persistence", "median", "fixed", "evidence"}));
   sunvo::cli::addEnumOption(app, "--vertical-drift-rule", options.fusion.vertical_drift_adaptation,

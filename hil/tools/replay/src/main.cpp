@@ -118,8 +118,7 @@ int main(int argc, char** argv) {
   app.add_flag("--self-calib", self_calib,
                "online stereo self-calibration of the right camera (measures the right rows); its "
                "estimate per frame in OUT/self_calibration_<run>.csv");
-  sunvo::cli::addSelfCalibrationRateOptions(app, options.pipeline.self_calibration);
-  sunvo::cli::addDisparityBiasOption(app, options.pipeline.self_calibration);
+  sunvo::cli::addSelfCalibrationOptions(app, options.pipeline.self_calibration);
   app.add_flag("--measure-right-rows", options.pipeline.frontend.measure_v_right,
                "the front end measures each match's right row and column by a 2-D step "
                "(frontend.measure_v_right; on with --self-calib), without the self-calibration");

@@ -223,11 +223,13 @@ void addTiltWalkRangeOptions(CLI::App& app, FusionOptions& fusion) {
       ->check(CLI::Range(1e-3, 10.0));
 }
 
-// The stereo self-calibration's drift rate (selfcal::StereoSelfCalibrationOptions,
-// docs/selfcal.md), the same in every program that runs it: --self-calib-rate-deg,
-// --self-calib-rate-frames.
+// The stereo self-calibration's options (selfcal::StereoSelfCalibrationOptions, docs/selfcal.md),
+// the same in every program that runs it: its drift rate, --self-calib-rate-deg and
+// --self-calib-rate-frames, and the rig's constant disparity bias, --disparity-bias-px, measured
+// offline (scripts/disparity_bias.py with poses of a known length; docs/disparity_bias.md) and
+// taken out of every observation with or without the self-calibration.
 template <class SelfCalibrationOptions>
-void addSelfCalibrationRateOptions(CLI::App& app, SelfCalibrationOptions& sc) {
+void addSelfCalibrationOptions(CLI::App& app, SelfCalibrationOptions& sc) {
   app.add_option("--self-calib-rate-deg", sc.drift_rate_sigma_deg,
                  "std of the self-calibration's pitch/roll drift rate, deg/frame (0 = random walk "
                  "only)")
@@ -235,13 +237,6 @@ void addSelfCalibrationRateOptions(CLI::App& app, SelfCalibrationOptions& sc) {
   app.add_option("--self-calib-rate-frames", sc.drift_rate_time_frames,
                  "correlation time of that drift rate, frames")
       ->check(CLI::Range(1.0, 1e7));
-}
-
-// The rig's constant disparity bias, measured offline (scripts/disparity_bias.py with poses of a
-// known length; docs/disparity_bias.md) and taken out of every observation, with or without the
-// self-calibration: --disparity-bias-px (selfcal::StereoSelfCalibrationOptions).
-template <class SelfCalibrationOptions>
-void addDisparityBiasOption(CLI::App& app, SelfCalibrationOptions& sc) {
   app.add_option("--disparity-bias-px", sc.disparity_bias_px,
                  "the rig's measured disparity bias, px: d - bias is used "
                  "(self_calibration.disparity_bias_px; 0 = none)")
