@@ -136,8 +136,9 @@ def observations(by_landmark, poses, calib, min_parallax_deg):
 def fit(rows, roll):
     """Least squares of d = a + s fu b / z [+ c (v - cv)], trimmed at 3 sigma three times."""
     n = 3 if roll else 2
-    params, sd = None, 0.0
-    for _ in range(4):
+    for trim in range(4):  # a fit, then three times: trim, fit again
+        if trim > 0:
+            rows = [row for row, r in zip(rows, res) if abs(r) < 3.0 * sd]
         normal = [[0.0] * n for _ in range(n)]
         rhs = [0.0] * n
         for d_z, d_m, dv in rows:
@@ -152,8 +153,7 @@ def fit(rows, roll):
         res = [d_m - (params[0] + params[1] * d_z + (params[2] * dv if roll else 0.0))
                for d_z, d_m, dv in rows]
         sd = math.sqrt(sum(r * r for r in res) / len(res))
-        rows = [row for row, r in zip(rows, res) if abs(r) < 3.0 * sd]
-    return params, sd, len(rows)
+    return params, sd, len(rows)  # the last fit, its residual std and the rows it used
 
 
 def main():
