@@ -153,7 +153,38 @@ def fit(rows, roll):
         res = [d_m - (params[0] + params[1] * d_z + (params[2] * dv if roll else 0.0))
                for d_z, d_m, dv in rows]
         sd = math.sqrt(sum(r * r for r in res) / len(res))
-    return params, sd, len(rows)  # the last fit, its residual std and the rows it used
+    # standard error of the bias: sd * sqrt((X^T X)^-1 [0][0]), from the last fit's normal matrix
+    inv0 = solve(normal, [1.0] + [0.0] * (n - 1))
+    se = sd * math.sqrt(max(inv0[0], 0.0)) if inv0 else float("inf")
+    return params, sd, len(rows), se  # the last fit, its residual std, the rows it used, se of a
+
+
+def read_calib(tracks):
+    """(fu, fv, cu, cv, baseline) of TRACKS/calib.txt."""
+    path = os.path.join(tracks, "calib.txt")
+    rows = read_numbers(path, 5)
+    if not rows:
+        fail(f"{path}: empty")
+    return rows[0]
+
+
+def read_poses(path):
+    """(rotation rows, translation) of every line of a KITTI pose file T_w_c."""
+    return [([p[0:3], p[4:7], p[8:11]], [p[3], p[7], p[11]]) for p in read_numbers(path, 12)]
+
+
+class NothingToFit(Exception):
+    """Too few landmarks consistent with the poses for a fit."""
+
+
+def measure(by_landmark, calib, poses, min_parallax_deg=3.0, roll=False, where="tracks"):
+    """The fit of d = a + s fu b / z [+ c (v - cv)] for the landmarks BY_LANDMARK under POSES:
+    (params, residual std, observations used, standard error of a). Raises NothingToFit."""
+    rows = observations(by_landmark, poses, calib, min_parallax_deg)
+    if len(rows) < 10:
+        raise NothingToFit(f"{where}: only {len(rows)} observations of landmarks seen over "
+                           f"{min_parallax_deg} deg; nothing to fit")
+    return fit(rows, roll)
 
 
 def main():
@@ -164,19 +195,16 @@ def main():
                     help="a landmark's smallest angle between its first and last ray, deg")
     ap.add_argument("--roll", action="store_true", help="fit the roll term c (v - cv) as well")
     a = ap.parse_args()
-    calib_rows = read_numbers(os.path.join(a.tracks, "calib.txt"), 5)
-    if not calib_rows:
-        fail(f"{os.path.join(a.tracks, 'calib.txt')}: empty")
-    poses = [([p[0:3], p[4:7], p[8:11]], [p[3], p[7], p[11]])
-             for p in read_numbers(a.poses, 12)]
-    rows = observations(read_tracks(os.path.join(a.tracks, "tracks.csv"), len(poses)), poses,
-                        calib_rows[0], a.min_parallax_deg)
-    if len(rows) < 10:
-        fail(f"{a.tracks}: only {len(rows)} observations of landmarks seen over "
-             f"{a.min_parallax_deg} deg; nothing to fit")
-    params, sd, used = fit(rows, a.roll)
+    calib = read_calib(a.tracks)
+    poses = read_poses(a.poses)
+    by_landmark = read_tracks(os.path.join(a.tracks, "tracks.csv"), len(poses))
+    try:
+        params, sd, used, se = measure(by_landmark, calib, poses, a.min_parallax_deg, a.roll,
+                                       a.tracks)
+    except NothingToFit as e:
+        fail(str(e))
     roll = f"  roll term {params[2]:+.3e} px/px" if a.roll else ""
-    print(f"disparity bias {params[0]:+.3f} px  scale {params[1]:.4f}{roll}  "
+    print(f"disparity bias {params[0]:+.3f} px (se {se:.3f})  scale {params[1]:.4f}{roll}  "
           f"({used} observations, residual std {sd:.3f} px)")
 
 

@@ -51,10 +51,11 @@ class DisparityBias(unittest.TestCase):
     def measure(self, folder, *extra):
         r = self.run_script(folder, os.path.join(folder, "gt_poses.txt"), *extra)
         self.assertEqual(r.returncode, 0, r.stderr)
-        m = re.search(r"disparity bias ([-+.\d]+) px\s+scale ([-+.\d]+)", r.stdout)
+        m = re.search(r"disparity bias ([-+.\d]+) px \(se ([.\d]+)\)\s+scale ([-+.\d]+)", r.stdout)
         self.assertIsNotNone(m, r.stdout)
+        self.assertLess(float(m.group(2)), 0.02, r.stdout)  # 0.05 px noise: a well-defined fit
         roll = re.search(r"roll term ([-+.\de]+)", r.stdout)
-        return float(m.group(1)), float(m.group(2)), float(roll.group(1)) if roll else None
+        return float(m.group(1)), float(m.group(3)), float(roll.group(1)) if roll else None
 
     def test_recovers_the_bias_with_a_free_scale(self):
         with tempfile.TemporaryDirectory() as d:
