@@ -157,11 +157,15 @@ def main():
         x, slope, se, _ = best
         print(f"disparity bias {x:+.3f} px (se {se:.3f})  (VO leaves {100 * slope:.0f} % of a "
               f"bias visible; {len(probe.runs)} VO runs)")
-        if slope < args.min_slope or se > args.max_se:
-            fail(f"{args.tracks}: the bias is not determined by this drive (VO leaves "
-                 f"{100 * slope:.1f} % of it visible, --min-slope {args.min_slope}; se "
-                 f"{se:.3f} px, --max-se {args.max_se}): use a longer drive, or measure it "
-                 "against poses of known length (scripts/disparity_bias.py)", 4)
+        if slope < args.min_slope:
+            fail(f"{args.tracks}: the bias is not observable enough from this drive: VO leaves "
+                 f"{100 * slope:.1f} % of a bias visible (--min-slope {args.min_slope}), so a small "
+                 f"error of its poses moves the fixed point {1 / max(slope, 1e-3):.0f} times as "
+                 "far (landmarks on one side of the path, docs/disparity_bias.md); measure the "
+                 "bias against poses of known length (scripts/disparity_bias.py)", 4)
+        if se > args.max_se:
+            fail(f"{args.tracks}: the bias is not determined to --max-se {args.max_se} px "
+                 f"(se {se:.3f} px): use a longer drive", 4)
         probe(x)
         if probe.runs[-1][4]:
             print(f"VO at the bias: {probe.runs[-1][4]}")

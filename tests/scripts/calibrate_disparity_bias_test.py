@@ -20,10 +20,10 @@ FU, CU, CV, BASE = 718.0, 607.0, 185.0, 0.54
 FRAMES = 300
 
 
-def write_drive(folder, bias_px, seed=7):
-    """300 frames at 1 m per frame with a slow weave in yaw, past 250 landmarks 3-15 m to either
-    side and 5-80 m ahead (about 60 in view per frame, like 0020's tracks); u, v and uR carry
-    0.3 px of noise, every disparity bias_px."""
+def write_drive(folder, bias_px, right_share=0.5, seed=7):
+    """300 frames at 1 m per frame with a slow weave in yaw, past 250 landmarks 3-15 m to the
+    side (right_share of them on the right) and 5-80 m ahead (about 60 in view per frame, like
+    0020's tracks); u, v and uR carry 0.3 px of noise, every disparity bias_px."""
     rng = random.Random(seed)
     os.makedirs(folder)
     poses, x, z = [], 0.0, 0.0
@@ -34,7 +34,7 @@ def write_drive(folder, bias_px, seed=7):
     landmarks = []
     for _ in range(250):
         psi, px, pz = poses[int(rng.uniform(0, FRAMES))]
-        side = rng.choice((-1.0, 1.0))
+        side = 1.0 if rng.random() < right_share else -1.0
         lateral, ahead, height = side * rng.uniform(3, 15), rng.uniform(5, 80), rng.uniform(-3, 1.6)
         landmarks.append((px + math.cos(psi) * lateral + math.sin(psi) * ahead, height,
                           pz - math.sin(psi) * lateral + math.cos(psi) * ahead))
@@ -105,6 +105,11 @@ class CalibrateDisparityBias(unittest.TestCase):
             r = self.run_script(folder, "--range", "0.2", "1.0", "--step", "0.4")
             self.assertEqual(r.returncode, 3, r.stdout + r.stderr)
             self.assertIn("widen --range", r.stderr)
+            one_sided = os.path.join(d, "one_sided")  # VO turns the bias into a rotation
+            write_drive(one_sided, -0.4, right_share=0.9)
+            r = self.run_script(one_sided)
+            self.assertEqual(r.returncode, 4, r.stdout + r.stderr)
+            self.assertIn("not observable enough", r.stderr)
             r = self.run_script(folder, "--", "--disparity-bias-px", "0.1")
             self.assertNotEqual(r.returncode, 0)
             self.assertIn("--disparity-bias-px is what this script sets", r.stderr)
