@@ -88,7 +88,9 @@ def line_root(points):
     mean = sum(x for x, _ in points) / n
     sxx = sum((x - mean) ** 2 for x, _ in points)
     g_mean = sum(g for _, g in points) / n
-    k = sum((x - mean) * (g - g_mean) for x, g in points) / sxx
+    k = sum((x - mean) * (g - g_mean) for x, g in points) / sxx if sxx > 0.0 else 0.0
+    if k == 0.0:
+        return mean, 0.0, float("inf")
     root = mean - g_mean / k
     res = [g - g_mean - k * (x - mean) for x, g in points]
     sd = math.sqrt(sum(r * r for r in res) / max(n - 2, 1))
@@ -130,7 +132,7 @@ def main():
         probe = Probe(args, vo_args)
         print(f"grid {lo:+.2f} .. {hi:+.2f} px, step {args.step:.2f}"
               f"{', roll term fitted (VO runs with --self-calib)' if probe.roll else ''}")
-        count = int(round((hi - lo) / args.step))
+        count = max(1, int(round((hi - lo) / args.step)))
         grid = [(x, probe(x)) for x in (lo + i * (hi - lo) / count for i in range(count + 1))]
         brackets = [(a, b) for a, b in zip(grid, grid[1:])
                     if a[1] is not None and b[1] is not None and a[1] > 0 >= b[1]]
@@ -140,13 +142,14 @@ def main():
         roots = []
         for (a, g_a), (b, g_b) in brackets:  # a line through local points around each crossing
             guess = a - g_a * (b - a) / (g_b - g_a)
-            local = [guess + args.local * i / 2 for i in range(-2, 3)]
+            local = [min(5.0, max(-5.0, guess + args.local * i / 2)) for i in range(-2, 3)]
+            first = len(probe.runs)
             points = [(x, probe(x)) for x in local]
             points = [(x, g) for x, g in points if g is not None]
             if len(points) < 3:
                 continue
             root, k, se = line_root(points)
-            used = sum(run[2] for run in probe.runs[-len(local):]) // len(local)
+            used = sum(run[2] for run in probe.runs[first:]) // len(points)
             roots.append((root, -k, se, used))
         if not roots:
             fail("no VO run near the crossing gave a fit", 3)
@@ -166,8 +169,7 @@ def main():
         if se > args.max_se:
             fail(f"{args.tracks}: the bias is not determined to --max-se {args.max_se} px "
                  f"(se {se:.3f} px): use a longer drive", 4)
-        probe(x)
-        if probe.runs[-1][4]:
+        if probe(x) is not None and probe.runs[-1][4]:
             print(f"VO at the bias: {probe.runs[-1][4]}")
         print(f"config: self_calibration.disparity_bias_px: {x:.3f}")
 
