@@ -92,8 +92,8 @@ class CalibrateDisparityBias(unittest.TestCase):
                               r.stdout)
                 at_bias = [ln for ln in r.stdout.splitlines() if ln.startswith("VO at the bias")]
                 drift[name] = (final_drift_pct(vo.stdout), final_drift_pct(at_bias[0]))
-            # the bias makes VO drift (about 2.4 %); with the calibrated bias entered it drifts
-            # like the unbiased rig (about 0.07 %)
+            # the bias makes VO drift (2.27 %); with the calibrated bias entered it drifts like
+            # the unbiased rig (0.17 % against 0.15 %)
             self.assertGreater(drift["biased"][0], 1.0, drift)
             self.assertLess(drift["biased"][1], 3.0 * drift["unbiased"][0] + 0.05, drift)
             self.assertLess(drift["unbiased"][1], 3.0 * drift["unbiased"][0] + 0.05, drift)
