@@ -14,8 +14,9 @@ fit (trimmed at 3 sigma, three times) of
 returns the bias a. The scale s is free, so poses with a wrong length (a speed error) still give
 a; --roll adds the right camera's roll term c (v - cv) of the disparity.
 With the ground truth's poses this measures the tracks. With the odometry's own poses it reads
-what VO could learn from its own tracks (docs/sparse_tracks.md, "The disparity bias VO cannot
-see": on 0020 it reads about 0 whatever the bias, the poses absorb it).
+what VO leaves visible of a bias: most of it where the landmarks surround the path, a fifth on
+0020's one-sided tracks (docs/disparity_bias.md); scripts/calibrate_disparity_bias.py finds the
+bias as the fixed point of VO and this fit.
 No dependencies beyond Python.
 Usage: disparity_bias.py TRACKS POSES [--min-parallax-deg DEG] [--roll]
 """
