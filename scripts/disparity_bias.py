@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""A track folder's constant disparity bias, measured against poses: the stereo error VO cannot see.
+"""A track folder's constant disparity bias, measured against poses: the stereo error VO hardly sees.
 
 A right camera turned by a small yaw, or a right principal point a few tenths of a pixel off, adds
 the same offset a to every disparity: d = fu b / z + a. Near points hardly notice it, far points
