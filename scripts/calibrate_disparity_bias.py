@@ -11,9 +11,11 @@ intercept left. So the bias is the root of
     g(A) = r(A) - A,
 
 found here without any ground truth: g on a grid of A (a sunvo_track_vo run and a fit each), then
-regula falsi inside the bracket where g changes sign from + to -. The slope -g'(A) at the root is
-the share of a bias that VO leaves visible; near 0 the bias is not observable from this drive
-(the landmarks do not surround the path, docs/disparity_bias.md) and the script says so.
+a least-squares line through five runs around each place where g changes sign from + to -, whose
+root is the bias. The line's slope -g' is the share of a bias that VO leaves visible; under
+--min-slope the bias is not observable enough from this drive (the landmarks do not surround the
+path, docs/disparity_bias.md) and the script refuses it, as it does a root whose se exceeds
+--max-se.
 With --self-calib among the VO options the right camera's roll is taken out by VO, and the fit
 models it (the roll term c (v - cv)); without it the fit returns the constant that best stands
 for both.
