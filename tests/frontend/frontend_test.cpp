@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "../support/kitti_first_frames.hpp"
+#include "synthetic_pair.hpp"
 #include "sunvo/frontend/stereo_frontend.hpp"
 
 #if defined(SUNVO_HAVE_ALLOC_COUNTER)
@@ -23,43 +24,6 @@
 
 namespace sunvo {
 namespace {
-
-constexpr int kW = 640;  // synthetic image size, px
-constexpr int kH = 240;
-
-// A random texture with blobs of a few pixels: uniform noise at 1/3 resolution, upsampled by
-// bicubic interpolation; float, (kW + 200) x (kH + 100) so that shifted crops stay inside.
-cv::Mat makeTexture(std::uint64_t seed) {
-  cv::RNG rng(seed);
-  cv::Mat coarse((kH + 100) / 3 + 2, (kW + 200) / 3 + 2, CV_32F);
-  rng.fill(coarse, cv::RNG::UNIFORM, 0.0, 255.0);
-  cv::Mat fine;
-  cv::resize(coarse, fine, cv::Size(coarse.cols * 3, coarse.rows * 3), 0, 0, cv::INTER_CUBIC);
-  return fine;
-}
-
-// out(x, y) = texture(x + ox, y + oy) as CV_8UC1 of kW x kH (bicubic for fractional offsets).
-cv::Mat crop(const cv::Mat& texture, double ox, double oy) {
-  const cv::Mat m = (cv::Mat_<double>(2, 3) << 1.0, 0.0, ox + 50.0, 0.0, 1.0, oy + 30.0);
-  cv::Mat f;
-  cv::warpAffine(texture, f, m, cv::Size(kW, kH), cv::INTER_CUBIC | cv::WARP_INVERSE_MAP,
-                 cv::BORDER_REFLECT);
-  cv::Mat out;
-  f.convertTo(out, CV_8U);
-  return out;
-}
-
-StereoCamera syntheticCamera() {
-  StereoCamera cam;
-  cam.fu = 500.0;
-  cam.fv = 500.0;
-  cam.cu = kW / 2.0;
-  cam.cv = kH / 2.0;
-  cam.baseline_m = 0.5;
-  cam.width = kW;
-  cam.height = kH;
-  return cam;
-}
 
 std::map<std::int64_t, StereoObservation> byId(const FrameFeatures& f) {
   std::map<std::int64_t, StereoObservation> m;
@@ -88,6 +52,8 @@ TEST(FrontendOptions, ErrorNamesTheBadKey) {
       {"predicted_search_radius", [](FrontendOptions& o) { o.predicted_search_radius = 200; }},
       {"max_sad", [](FrontendOptions& o) { o.max_sad = 9000; }},
       {"circular_tolerance_px", [](FrontendOptions& o) { o.circular_tolerance_px = -1.0; }},
+      {"correct_edge_columns", [](FrontendOptions& o) { o.correct_edge_columns = true; }},
+      {"row_offset_memory_frames", [](FrontendOptions& o) { o.row_offset_memory_frames = 0; }},
   };
   for (const Case& c : cases) {
     FrontendOptions o;
@@ -550,8 +516,12 @@ TEST_F(KittiFrontend, Deterministic) {
 TEST_F(KittiFrontend, NoHeapAllocationAfterTheFirstFrame) {
 #if defined(SUNVO_HAVE_ALLOC_COUNTER)
   ASSERT_TRUE(runtime::allocCounterActive());
+  // With the right rows measured and the edge columns moved too (their paths allocate nothing).
+  FrontendOptions opt;
+  opt.measure_v_right = true;
+  opt.correct_edge_columns = true;
   StereoFrontend fe;
-  ASSERT_TRUE(fe.init(FrontendOptions{}, sample_->camera).isOk());
+  ASSERT_TRUE(fe.init(opt, sample_->camera).isOk());
   FrameFeatures out;  // capacity not reserved: the first process() may allocate it
   ASSERT_TRUE(fe.process(sample_->frames[0].left, sample_->frames[0].right, 0, 0, out).isOk());
   std::uint64_t total = 0;

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <ctime>
+#include <limits>
 #include <string>
 #include <utility>
 
@@ -69,6 +70,12 @@ Status FrontendOptions::validate() const {
     return badKey("circular_tolerance_px", "must be in [0, 100] px");
   }
   if (lr_tolerance < 0 || lr_tolerance > 10) return badKey("lr_tolerance", "must be in [0, 10] px");
+  if (correct_edge_columns && !measure_v_right) {
+    return badKey("correct_edge_columns", "needs measure_v_right: true (the rows it fits)");
+  }
+  if (row_offset_memory_frames < 1 || row_offset_memory_frames > 10000) {
+    return badKey("row_offset_memory_frames", "must be in [1, 10000] frames");
+  }
   return Status::ok();
 }
 
@@ -139,6 +146,13 @@ Status StereoFrontend::init(const FrontendOptions& options, const StereoCamera& 
   hint_du_ = 0.0F;
   hint_dv_ = 0.0F;
   stats_ = FrontendStats{};
+  edge_slope_.assign(max_feat, 0.0F);
+  row_ata_ = {};
+  row_atb_ = {};
+  row_weight_ = 0.0;
+  row_sse_ = 0.0;
+  row_plane_ = {};
+  row_plane_valid_ = false;
   initialized_ = true;
   return Status::ok();
 }
@@ -242,7 +256,9 @@ std::int64_t StereoFrontend::denseCost(int ul, int ur, int v, int dv_right) cons
 // measured too (measureRightRow); else v_right = v_left, as rectification promises. A rig whose
 // rectification is off by a fraction of a pixel shows it there (what the stereo
 // self-calibration estimates).
-bool StereoFrontend::refineStereo(int li, int ri, StereoObservation& obs) const {
+bool StereoFrontend::refineStereo(int li, int ri, StereoObservation& obs,
+                                  float* edge_slope) const {
+  *edge_slope = std::numeric_limits<float>::quiet_NaN();
   const CandidateSet& l = left_[static_cast<std::size_t>(cur_)];
   const CandidateSet& r = right_[static_cast<std::size_t>(cur_)];
   const Keypoint& lk = l.kp[static_cast<std::size_t>(li)];
@@ -277,7 +293,7 @@ bool StereoFrontend::refineStereo(int li, int ri, StereoObservation& obs) const 
     int sv = 0;
     if (up < cost[c] && up <= down) sv = -1;
     if (down < cost[c] && down < up) sv = 1;
-    measureRightRow(lk, ur, sv, obs);
+    measureRightRow(lk, ur, sv, obs, edge_slope);
   }
   return true;
 }
@@ -295,8 +311,8 @@ bool StereoFrontend::refineStereo(int li, int ri, StereoObservation& obs) const 
 // |du| <= 1 px, u_right = ur + du + du_left in place of the parabola's. Both are kept only when
 // the window determines them: the smaller eigenvalue of the 2x2 matrix at least
 // kMinEigenvalueRatio of the larger (not along an edge) and |dv| <= 1 px.
-void StereoFrontend::measureRightRow(const Keypoint& lk, int ur, int sv,
-                                     StereoObservation& obs) const {
+void StereoFrontend::measureRightRow(const Keypoint& lk, int ur, int sv, StereoObservation& obs,
+                                     float* edge_slope) const {
   const std::ptrdiff_t right_shift = static_cast<std::ptrdiff_t>(sv) * stride_;
   // A gradient stored at 0 or 255 was clipped (|g| > 255): not linear in the offset.
   auto clipped = [](std::uint8_t g) { return g == 0 || g == 255; };
@@ -331,7 +347,12 @@ void StereoFrontend::measureRightRow(const Keypoint& lk, int ur, int sv,
   const double disc = std::sqrt(std::max(0.0, 0.25 * tr * tr - det));
   const double lmin = 0.5 * tr - disc;
   const double lmax = 0.5 * tr + disc;
-  if (!(det > 0.0) || !(lmin >= kMinEigenvalueRatio * lmax)) return;
+  if (!(lmin >= kMinEigenvalueRatio * lmax)) {
+    // An edge: the row stays unmeasured; its slope is what correctEdgeColumns needs.
+    if (a11 > 0.0) *edge_slope = static_cast<float>(a12 / a11);
+    return;
+  }
+  if (!(det > 0.0)) return;
   const double dv = (a11 * b2 - a12 * b1) / det;
   const double du = (a22 * b1 - a12 * b2) / det;
   if (!std::isfinite(dv) || std::abs(dv) > 1.0) return;
@@ -443,11 +464,13 @@ Status StereoFrontend::process(const cv::Mat& left, const cv::Mat& right, TimeNs
     if (result == 3) ++stats_.lost_circle;
     if (result != 0) continue;
     StereoObservation obs;
-    if (!refineStereo(d, c, obs)) {
+    float slope = 0.0F;
+    if (!refineStereo(d, c, obs, &slope)) {
       ++stats_.lost_range;
       continue;
     }
     obs.landmark_id = tr.id;
+    edge_slope_[out.observations.size()] = slope;
     out.observations.push_back(obs);
     left_used_[static_cast<std::size_t>(d)] = 1;
     const Keypoint& ka = lp.kp[static_cast<std::size_t>(tr.left)];
@@ -507,8 +530,10 @@ Status StereoFrontend::process(const cv::Mat& left, const cv::Mat& right, TimeNs
       const Keypoint& kl = lc.kp[static_cast<std::size_t>(best)];
       if (std::abs(kb.u - kl.u) > lr_tol || std::abs(kb.v - kl.v) > lr_tol) continue;
       StereoObservation obs;
-      if (!refineStereo(best, r, obs)) continue;
+      float slope = 0.0F;
+      if (!refineStereo(best, r, obs, &slope)) continue;
       obs.landmark_id = next_id_++;
+      edge_slope_[out.observations.size()] = slope;
       out.observations.push_back(obs);
       left_used_[static_cast<std::size_t>(best)] = 1;
       tracks_cur_.push_back(Track{obs.landmark_id, best, r, 0.0F, 0.0F, false});
@@ -516,6 +541,7 @@ Status StereoFrontend::process(const cv::Mat& left, const cv::Mat& right, TimeNs
       ++stats_.new_features;
     }
   }
+  if (options_.correct_edge_columns) correctEdgeColumns(out);
   const std::int64_t t3 = nowNs();
   const std::int64_t c3 = threadCpuNs();
   stats_.detect_ns = t1 - t0;

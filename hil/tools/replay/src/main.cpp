@@ -122,6 +122,9 @@ int main(int argc, char** argv) {
   app.add_flag("--measure-right-rows", options.pipeline.frontend.measure_v_right,
                "the front end measures each match's right row and column by a 2-D step "
                "(frontend.measure_v_right; on with --self-calib), without the self-calibration");
+  app.add_flag("--correct-edge-columns", options.pipeline.frontend.correct_edge_columns,
+               "matches along edges get their column moved by the rig's row offset there "
+               "(frontend.correct_edge_columns; needs --measure-right-rows or --self-calib)");
   sunvo::cli::addWindowPriorOptions(app, options.pipeline.vo.window);
   app.add_option("--estimators", estimator_names,
                  "also VO + sun from these image estimators: lalonde, lalonde_vo, sun_cnn")

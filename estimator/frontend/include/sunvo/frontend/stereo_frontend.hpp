@@ -68,6 +68,12 @@ struct FrontendOptions {
                                        //   determines it (v_right_measured; else v_right =
                                        //   v_left), and its column from the same 2-D step;
                                        //   what stereo self-calibration needs
+  bool correct_edge_columns = false;   // needs measure_v_right: a match along an edge (its row
+                                       //   not measured) gets its column moved along the edge
+                                       //   by the rig's row offset there, from a plane fitted to
+                                       //   the measured rows of recent frames (correctEdgeColumns)
+  int row_offset_memory_frames = 20;   // frames, [1, 10000]: the plane's memory (each frame's
+                                       //   rows weigh 1 - 1/N less per later frame)
 
   Status validate() const;
   template <class Self, class V>
@@ -91,6 +97,8 @@ struct FrontendOptions {
     v("circular_tolerance_px", s.circular_tolerance_px);
     v("lr_tolerance", s.lr_tolerance);
     v("measure_v_right", s.measure_v_right);
+    v("correct_edge_columns", s.correct_edge_columns);
+    v("row_offset_memory_frames", s.row_offset_memory_frames);
   }
 };
 
@@ -114,6 +122,16 @@ struct FrontendStats {
   int lost_range = 0;                 // refined disparity outside [min_disparity, max_disparity]
   int new_features = 0;               // got a new id
   bool candidates_truncated = false;  // max_candidates was reached in one of the images
+  // correct_edge_columns: the row-offset plane v_right - v_left = a + b (u - cu) / fu +
+  // c (v - cv) / fv after this frame (px), the measured rows it took from this frame, and the
+  // edge matches whose column it moved.
+  double row_offset_a_px = 0.0;
+  double row_offset_b_px = 0.0;
+  double row_offset_c_px = 0.0;
+  int row_offset_rows_used = 0;
+  int edge_columns_moved = 0;
+  bool row_offset_restarted = false;  // most of this frame's rows missed the plane: refitted
+                                      //   from this frame alone
 };
 
 class StereoFrontend {
@@ -210,11 +228,17 @@ class StereoFrontend {
   std::int64_t denseCost(int ul, int ur, int v, int dv_right) const;
   // Subpixel u of the right match ri of left candidate li (in the current frame); false if the
   // disparity falls outside the range.
-  bool refineStereo(int li, int ri, StereoObservation& obs) const;
+  // edge_slope: g_v / g_u of the right window (the Lucas-Kanade matrix's a12 / a11) when it is
+  // an edge whose row is not measured (measure_v_right), else NaN.
+  bool refineStereo(int li, int ri, StereoObservation& obs, float* edge_slope) const;
   // measure_v_right: obs.v_right (and v_right_measured) of left keypoint lk matched at right
   // column ur and row lk.v + sv (whole pixels), from the current gradient images; obs.u_right
   // from the same step when its disparity stays in range.
-  void measureRightRow(const Keypoint& lk, int ur, int sv, StereoObservation& obs) const;
+  void measureRightRow(const Keypoint& lk, int ur, int sv, StereoObservation& obs,
+                       float* edge_slope) const;
+  // correct_edge_columns: updates the row-offset plane from out's measured rows and moves the
+  // column of every edge match (edge_slope_ finite) along its edge (frontend_rows.cpp).
+  void correctEdgeColumns(FrameFeatures& out);
 
   FrontendOptions options_;
   StereoCamera camera_;
@@ -255,6 +279,16 @@ class StereoFrontend {
   float hint_du_ = 0.0F;
   float hint_dv_ = 0.0F;
   FrontendStats stats_;
+  // correct_edge_columns: per output observation its edge slope (NaN: not an edge), and the
+  // row-offset plane's decayed normal equations over (1, x, y), x = (u - cu) / fu,
+  // y = (v - cv) / fv, with its weighted squared residuals.
+  std::vector<float> edge_slope_;
+  std::array<double, 6> row_ata_{};  // upper triangle: 11 12 13 22 23 33
+  std::array<double, 3> row_atb_{};
+  double row_weight_ = 0.0;
+  double row_sse_ = 0.0;
+  std::array<double, 3> row_plane_{};
+  bool row_plane_valid_ = false;
 };
 
 }  // namespace sunvo
