@@ -94,11 +94,12 @@ TEST(FrontendRows, EdgeColumnsFollowTheRowPlane) {
   const double b = 0.8 * syntheticCamera().fu / (kW / 2.0);
   const EdgeErrors off = run(false, a, b, 0.0);
   const EdgeErrors on = run(true, a, b, 0.0);
-  std::printf("edges %d / %d, disparity error mean %+.3f / %+.3f px, mean |.| %.3f -> %.3f px; "
-              "plane a %+.3f b %+.3f c %+.3f px (truth %+.3f %+.3f 0), %d moved\n",
-              off.edges, on.edges, off.edge_mean, on.edge_mean, off.edge_abs, on.edge_abs,
-              on.stats.row_offset_a_px, on.stats.row_offset_b_px, on.stats.row_offset_c_px, a, b,
-              on.stats.edge_columns_moved);
+  std::printf(
+      "edges %d / %d, disparity error mean %+.3f / %+.3f px, mean |.| %.3f -> %.3f px; "
+      "plane a %+.3f b %+.3f c %+.3f px (truth %+.3f %+.3f 0), %d moved\n",
+      off.edges, on.edges, off.edge_mean, on.edge_mean, off.edge_abs, on.edge_abs,
+      on.stats.row_offset_a_px, on.stats.row_offset_b_px, on.stats.row_offset_c_px, a, b,
+      on.stats.edge_columns_moved);
   ASSERT_GE(on.edges, 40);
   EXPECT_EQ(off.stats.edge_columns_moved, 0);
   EXPECT_GE(on.stats.edge_columns_moved, on.edges / 2);

@@ -15,8 +15,8 @@
 #include <vector>
 
 #include "../support/kitti_first_frames.hpp"
-#include "synthetic_pair.hpp"
 #include "sunvo/frontend/stereo_frontend.hpp"
+#include "synthetic_pair.hpp"
 
 #if defined(SUNVO_HAVE_ALLOC_COUNTER)
 #include "sunvo/runtime/alloc_counter.hpp"

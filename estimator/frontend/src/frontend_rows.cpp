@@ -21,12 +21,11 @@
 // same. Edges flatter than kMaxEdgeSlope are left as they are: there the row does not fix the
 // column.
 //
-// Measured on the held-out antialiased twins (docs/selfcal.md, "Edges on a miscalibrated rig").
-
-#include <algorithm>
-#include <cmath>
+// Measured, and why it is off by default: docs/edge_columns.md.
 
 #include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
 
 #include "sunvo/frontend/stereo_frontend.hpp"
 
@@ -116,7 +115,8 @@ void StereoFrontend::correctEdgeColumns(FrameFeatures& out) {
     const float s = edge_slope_[i];
     if (!std::isfinite(s) || std::abs(static_cast<double>(s)) > kMaxEdgeSlope) continue;
     StereoObservation& o = out.observations[i];
-    const double dv = plane((o.u_left - camera_.cu) / camera_.fu, (o.v_left - camera_.cv) / camera_.fv);
+    const double dv =
+        plane((o.u_left - camera_.cu) / camera_.fu, (o.v_left - camera_.cv) / camera_.fv);
     const double u_right = o.u_right - static_cast<double>(s) * dv;
     const double disparity = o.u_left - u_right;
     if (!(disparity >= options_.min_disparity) || !(disparity <= options_.max_disparity)) continue;

@@ -256,8 +256,7 @@ std::int64_t StereoFrontend::denseCost(int ul, int ur, int v, int dv_right) cons
 // measured too (measureRightRow); else v_right = v_left, as rectification promises. A rig whose
 // rectification is off by a fraction of a pixel shows it there (what the stereo
 // self-calibration estimates).
-bool StereoFrontend::refineStereo(int li, int ri, StereoObservation& obs,
-                                  float* edge_slope) const {
+bool StereoFrontend::refineStereo(int li, int ri, StereoObservation& obs, float* edge_slope) const {
   *edge_slope = std::numeric_limits<float>::quiet_NaN();
   const CandidateSet& l = left_[static_cast<std::size_t>(cur_)];
   const CandidateSet& r = right_[static_cast<std::size_t>(cur_)];

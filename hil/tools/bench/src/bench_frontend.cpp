@@ -5,7 +5,8 @@
 //
 // Usage: sunvo_bench_frontend [--frames=N] [--warmup=N] [--data=DIR] [--cpu=K] [--benchmark_*]
 //   --cpu=K pins the process to CPU K (sched_setaffinity) before anything runs; --benchmark_*
-//   options go to Google Benchmark. Options: sunvo_bench_frontend --help.
+//   options go to Google Benchmark; --measure-right-rows and --correct-edge-columns turn those
+//   front-end options on. Options: sunvo_bench_frontend --help.
 
 #include <benchmark/benchmark.h>
 
@@ -46,14 +47,14 @@ struct Results {
 };
 
 Config g_config;
+sunvo::FrontendOptions g_options;  // defaults, with the flags below
 Results g_results;
 sunvo::bench::KittiFrames g_sample;
 
 void benchFrontend(benchmark::State& state) {
   sunvo::StereoFrontend fe;
-  sunvo::FrontendOptions opt;
   const std::uint64_t bytes0 = sunvo::runtime::allocatedBytes();
-  const sunvo::Status st = fe.init(opt, g_sample.camera);
+  const sunvo::Status st = fe.init(g_options, g_sample.camera);
   g_results.init_bytes = sunvo::runtime::allocatedBytes() - bytes0;
   if (!st.isOk()) {
     state.SkipWithError(st.toString().c_str());
@@ -132,8 +133,9 @@ void printSummary() {
   if (!r.ok) return;
   std::printf(
       "\nfront end on %zu frames of %dx%d (00_first_frames ping-pong), after %d warm-up "
-      "frames, single thread (cv::setNumThreads(0))\n",
-      r.total_ms.size(), g_sample.camera.width, g_sample.camera.height, g_config.warmup);
+      "frames, single thread (cv::setNumThreads(0)); measure_v_right %s, correct_edge_columns %s\n",
+      r.total_ms.size(), g_sample.camera.width, g_sample.camera.height, g_config.warmup,
+      g_options.measure_v_right ? "on" : "off", g_options.correct_edge_columns ? "on" : "off");
   std::printf("%-32s %9s %9s %9s %9s\n", "stage [ms]", "median", "p95", "p99", "max");
   auto row = [](const char* name, const std::vector<double>& v) {
     std::printf("%-32s %9.3f %9.3f %9.3f %9.3f\n", name, percentile(v, 0.5), percentile(v, 0.95),
@@ -177,6 +179,10 @@ int main(int argc, char** argv) {
   CLI::App app{"Stereo front-end time and heap allocations per frame on real KITTI frames.",
                kProgram};
   sunvo::bench::addBenchOptions(app, g_config);
+  app.add_flag("--measure-right-rows", g_options.measure_v_right,
+               "frontend.measure_v_right (what the self-calibration needs)");
+  app.add_flag("--correct-edge-columns", g_options.correct_edge_columns,
+               "frontend.correct_edge_columns (needs --measure-right-rows)");
   if (auto code = sunvo::bench::startBenchmark(app, argc, argv, kProgram, g_config, &g_sample)) {
     return *code;
   }
