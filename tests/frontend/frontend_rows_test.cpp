@@ -54,6 +54,14 @@ cv::Mat rightWithRowPlane(const cv::Mat& texture, double d, double a, double b, 
   return out;
 }
 
+// The options under test: right rows measured, edge columns moved when `correct`.
+FrontendOptions rowOptions(bool correct) {
+  FrontendOptions opt;
+  opt.measure_v_right = true;
+  opt.correct_edge_columns = correct;
+  return opt;
+}
+
 struct EdgeErrors {
   double edge_mean = 0.0;  // signed mean disparity error of the unmeasured matches, px
   double edge_abs = 0.0;   // their mean |error|, px
@@ -65,11 +73,8 @@ struct EdgeErrors {
 EdgeErrors run(bool correct, double a, double b, double c) {
   const cv::Mat texture = makeEdgyTexture(5);
   const double d = 15.0;
-  FrontendOptions opt;
-  opt.measure_v_right = true;
-  opt.correct_edge_columns = correct;
   StereoFrontend fe;
-  EXPECT_TRUE(fe.init(opt, syntheticCamera()).isOk());
+  EXPECT_TRUE(fe.init(rowOptions(correct), syntheticCamera()).isOk());
   const cv::Mat left = crop(texture, 0, 0);
   const cv::Mat right = rightWithRowPlane(texture, d, a, b, c);
   FrameFeatures out;
@@ -127,11 +132,8 @@ TEST(FrontendRows, RectifiedPairIsLeftAlone) {
 TEST(FrontendRows, AKnockRestartsThePlane) {
   const cv::Mat texture = makeEdgyTexture(6);
   const double d = 15.0;
-  FrontendOptions opt;
-  opt.measure_v_right = true;
-  opt.correct_edge_columns = true;
   StereoFrontend fe;
-  ASSERT_TRUE(fe.init(opt, syntheticCamera()).isOk());
+  ASSERT_TRUE(fe.init(rowOptions(true), syntheticCamera()).isOk());
   const cv::Mat left = crop(texture, 0, 0);
   FrameFeatures out;
   const cv::Mat before = rightWithRowPlane(texture, d, 0.6, 0.0, 0.0);

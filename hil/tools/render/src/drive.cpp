@@ -135,13 +135,17 @@ Eigen::Vector3d rightCameraErrorDeg(const RigErrorOptions& o, double progress) {
           lerp(o.right_yaw_start_deg, o.right_yaw_end_deg)};
 }
 
+Eigen::Matrix3d rightCameraTurn(const Eigen::Vector3d& roll_pitch_yaw_deg) {
+  const Eigen::Vector3d rad = roll_pitch_yaw_deg * (kPi / 180.0);
+  return (Eigen::AngleAxisd(rad.x(), Eigen::Vector3d::UnitZ()) *
+          Eigen::AngleAxisd(rad.y(), Eigen::Vector3d::UnitX()) *
+          Eigen::AngleAxisd(rad.z(), Eigen::Vector3d::UnitY()))
+      .toRotationMatrix();
+}
+
 Isometry3 rightCameraError(const RigErrorOptions& o, double progress) {
-  const Eigen::Vector3d rad = rightCameraErrorDeg(o, progress) * (kPi / 180.0);
   Isometry3 T_c1nom_c1 = Isometry3::Identity();
-  T_c1nom_c1.linear() = (Eigen::AngleAxisd(rad.x(), Eigen::Vector3d::UnitZ()) *
-                         Eigen::AngleAxisd(rad.y(), Eigen::Vector3d::UnitX()) *
-                         Eigen::AngleAxisd(rad.z(), Eigen::Vector3d::UnitY()))
-                            .toRotationMatrix();
+  T_c1nom_c1.linear() = rightCameraTurn(rightCameraErrorDeg(o, progress));
   return T_c1nom_c1;
 }
 

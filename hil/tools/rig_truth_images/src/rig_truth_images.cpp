@@ -1,6 +1,5 @@
 #include "sunvo/rig_truth_images/rig_truth_images.hpp"
 
-#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -12,6 +11,7 @@
 #include <sstream>
 
 #include "sunvo/dataset/dataset.hpp"
+#include "sunvo/render/drive.hpp"
 
 namespace sunvo::rigtruth {
 namespace fs = std::filesystem;
@@ -41,14 +41,10 @@ Expected<std::vector<RigTurn>> readRigError(const std::string& path) {
 }
 
 Eigen::Matrix3d rightCameraTurn(const RigTurn& turn, const Axes& axes) {
-  const double k = M_PI / 180.0;
-  const double roll = axes.roll ? turn.roll_deg * k : 0.0;
-  const double pitch = axes.pitch ? turn.pitch_deg * k : 0.0;
-  const double yaw = axes.yaw ? turn.yaw_deg * k : 0.0;
-  return (Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitZ()) *
-          Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitX()) *
-          Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitY()))
-      .toRotationMatrix();
+  // The renderer's own composition, so the oracle undoes exactly what it did.
+  return render::rightCameraTurn({axes.roll ? turn.roll_deg : 0.0,
+                                  axes.pitch ? turn.pitch_deg : 0.0,
+                                  axes.yaw ? turn.yaw_deg : 0.0});
 }
 
 void warpToNominal(const cv::Mat& turned, const StereoCamera& camera,

@@ -59,6 +59,9 @@ struct RigErrorOptions {
 
 // The injected (roll, pitch, yaw) in degrees at `progress` (0 = first frame, 1 = last frame).
 Eigen::Vector3d rightCameraErrorDeg(const RigErrorOptions& o, double progress);
+// R_c1nominal_c1 of a right camera turned by (roll, pitch, yaw) degrees: Rz(roll) Rx(pitch)
+// Ry(yaw).
+Eigen::Matrix3d rightCameraTurn(const Eigen::Vector3d& roll_pitch_yaw_deg);
 // T_c1nominal_c1: the right camera's pose in the calibrated right-camera frame at `progress`.
 Isometry3 rightCameraError(const RigErrorOptions& o, double progress);
 
