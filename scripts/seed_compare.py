@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Pure VO under two option sets over many seeds of the simulated routes, compared pair by pair.
+"""One estimate (pure VO unless --estimate names another) under two option sets over many seeds of
+the simulated routes, compared pair by pair.
 
 One route's final drift swings by tens of per cent with the simulated tracks' noise draw alone
 (docs/lateral_prior.md), so "no worse than today (+-5 %)" judged on one or three seeds ranks
@@ -12,7 +13,10 @@ seeds B makes worse by more than --worse-pct, and the ratio of the means.
   python3 scripts/seed_compare.py --experiment build/release/bin/sunvo_experiment \
       --seeds 5-14 --out /tmp/study --b="--lateral-prior 0.1 --lever-m 0.88"
 
---compare-only reads OUT without running anything. Give an option set as --b="--x 1" (an argument
+With --estimate NAME (a row of the experiment's table, e.g. "VO+Sun (Sun-CNN-like) +vertical-like")
+that row is compared instead, and each set's row is also compared with its own pure VO (how many
+seeds it leaves worse than pure VO by more than --worse-pct). --compare-only reads OUT without
+running anything. Give an option set as --b="--x 1" (an argument
 that starts with -- needs the = form).
 """
 import argparse
@@ -77,14 +81,23 @@ def run_one(args, tag, options, seed):
     return None
 
 
-def read_pure_vo(path):
+def read_estimate(path, name=None):
+    """The metrics of the estimate called name (the first, pure VO, when None) in a metrics file."""
     try:
         with open(path) as f:
             estimates = json.load(f)["estimates"]
-        return [get(estimates[0]) for _, get in METRICS]
+        if name is None:
+            e = estimates[0]
+        else:
+            found = [e for e in estimates if e.get("name") == name]
+            if not found:
+                names = ", ".join(repr(e.get("name")) for e in estimates)
+                raise SystemExit(f"seed_compare: {path}: no estimate '{name}' (has {names})")
+            e = found[0]
+        return [get(e) for _, get in METRICS]
     except FileNotFoundError:
         raise SystemExit(f"seed_compare: {path}: missing (run without --compare-only)")
-    except (json.JSONDecodeError, KeyError, IndexError, TypeError) as e:
+    except (json.JSONDecodeError, KeyError, IndexError, TypeError, AttributeError) as e:
         raise SystemExit(f"seed_compare: {path}: not a metrics file of sunvo_experiment ({e!r})")
 
 
@@ -121,6 +134,7 @@ def main(argv):
     p.add_argument("--worse-pct", type=float, default=5.0)
     p.add_argument("--compare-only", action="store_true")
     p.add_argument("--json", help="also write the statistics here")
+    p.add_argument("--estimate", help="the table row to compare (default: the first, pure VO)")
     args = p.parse_args(argv)
     seeds = parse_seeds(args.seeds)
     if args.jobs < 1:
@@ -137,10 +151,10 @@ def main(argv):
     print(f"A: '{args.a}'  B: '{args.b}'  seeds {args.seeds} ({len(seeds)})")
     report = {}
     for route in args.routes.split(","):
-        a = [read_pure_vo(metrics_path(args.out, "a", s, route)) for s in seeds]
-        b = [read_pure_vo(metrics_path(args.out, "b", s, route)) for s in seeds]
+        a = [read_estimate(metrics_path(args.out, "a", s, route), args.estimate) for s in seeds]
+        b = [read_estimate(metrics_path(args.out, "b", s, route), args.estimate) for s in seeds]
         report[route] = {}
-        print(f"route {route}, pure VO:")
+        print(f"route {route}, {args.estimate or 'pure VO'}:")
         for i, (name, _) in enumerate(METRICS):
             st = summarize([x[i] for x in a], [x[i] for x in b], args.worse_pct)
             report[route][name] = st
@@ -148,6 +162,17 @@ def main(argv):
                   f"change {st['mean_change_pct']:+6.1f} % (se {st['se_pct']:.1f})  "
                   f"worse by >{args.worse_pct:g} % on {st['worse']}/{st['n']}  "
                   f"ratio of means {st['ratio_of_means']:.3f}")
+        if args.estimate is None:
+            continue
+        for tag, rows in (("a", a), ("b", b)):
+            pure = [read_estimate(metrics_path(args.out, tag, s, route)) for s in seeds]
+            for i, (name, _) in enumerate(METRICS):
+                st = summarize([x[i] for x in pure], [x[i] for x in rows], args.worse_pct)
+                report[route][f"{tag.upper()} against pure VO: {name}"] = st
+                print(f"  {tag.upper()} against its pure VO, {name:18s} change "
+                      f"{st['mean_change_pct']:+6.1f} % (se {st['se_pct']:.1f})  worse by "
+                      f">{args.worse_pct:g} % on {st['worse']}/{st['n']}  "
+                      f"ratio of means {st['ratio_of_means']:.3f}")
     if args.json:
         with open(args.json, "w") as f:
             json.dump(report, f, indent=1)

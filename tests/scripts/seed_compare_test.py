@@ -34,13 +34,17 @@ FAKE = textwrap.dedent("""\
     """)
 
 
-def write_metrics(d, tag, seed, route, final, rot=0.02, terr=0.5):
+def estimate(name, final, rot=0.02, terr=0.5):
+    return {"name": name, "table1": {"final_drift_m": final, "rot_armse_rad": rot},
+            "kitti_segments": {"t_err_pct": terr}}
+
+
+def write_metrics(d, tag, seed, route, final, rot=0.02, terr=0.5, more=()):
+    """A metrics file whose first estimate is pure VO; more: further estimates."""
     run = os.path.join(d, f"{tag}_s{seed}")
     os.makedirs(run, exist_ok=True)
-    e = {"table1": {"final_drift_m": final, "rot_armse_rad": rot},
-         "kitti_segments": {"t_err_pct": terr}}
     with open(os.path.join(run, f"route_{route}_metrics.json"), "w") as f:
-        json.dump({"estimates": [e]}, f)
+        json.dump({"estimates": [estimate("Pure VO", final, rot, terr), *more]}, f)
 
 
 class SeedCompare(unittest.TestCase):
@@ -69,6 +73,34 @@ class SeedCompare(unittest.TestCase):
             self.assertEqual(st["rot. ARMSE [1e-3]"]["worse"], 0)
             self.assertAlmostEqual(st["t_err [%]"]["mean_change_pct"], 0.0)
             self.assertIn("worse by >5 % on 2/3", r.stdout)
+
+    def test_a_named_estimate_against_the_other_set_and_its_own_pure_vo(self):
+        with tempfile.TemporaryDirectory() as d:
+            # Pure VO 10 under both sets; the fused row 8 / 11 (A) and 6 / 12 (B) on seeds 1 / 2.
+            for s, (fa, fb) in zip((1, 2), ((8.0, 6.0), (11.0, 12.0))):
+                write_metrics(d, "a", s, "00", 10.0, more=[estimate("VO+Sun", fa)])
+                write_metrics(d, "b", s, "00", 10.0, more=[estimate("VO+Sun", fb)])
+            out = os.path.join(d, "stats.json")
+            r = self.run_script("--compare-only", "--out", d, "--routes", "00", "--seeds", "1,2",
+                                "--estimate", "VO+Sun", "--json", out)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            st = json.load(open(out))["00"]
+            # B against A: -25 % and +9.09 %.
+            self.assertAlmostEqual(st["final drift [m]"]["mean_change_pct"],
+                                   50.0 * (-0.25 + 1.0 / 11.0))
+            self.assertAlmostEqual(st["final drift [m]"]["mean_b"], 9.0)
+            # Each set against its own pure VO: A -20 % / +10 %, B -40 % / +20 %.
+            self.assertAlmostEqual(st["A against pure VO: final drift [m]"]["mean_change_pct"], -5.0)
+            self.assertEqual(st["A against pure VO: final drift [m]"]["worse"], 1)
+            self.assertAlmostEqual(st["B against pure VO: final drift [m]"]["mean_change_pct"], -10.0)
+            self.assertEqual(st["B against pure VO: final drift [m]"]["worse"], 1)
+            self.assertIn("route 00, VO+Sun:", r.stdout)
+            # A name that is not in the table is named with the file and the names it has.
+            r = self.run_script("--compare-only", "--out", d, "--routes", "00", "--seeds", "1",
+                                "--estimate", "VO+Moon")
+            self.assertNotEqual(r.returncode, 0)
+            self.assertIn("no estimate 'VO+Moon'", r.stderr)
+            self.assertIn("'Pure VO', 'VO+Sun'", r.stderr)
 
     def test_runs_a_study_and_resumes(self):
         with tempfile.TemporaryDirectory() as d:
