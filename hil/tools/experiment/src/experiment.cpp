@@ -61,10 +61,7 @@ Expected<RunResult> runRoute(const Route& route, const std::optional<SunSourceSp
     source.emplace(spec->model);
   }
   const double kRad = M_PI / 180.0;
-  const Eigen::Vector3d true_up_w =
-      Eigen::AngleAxisd(options.true_up_roll_deg * kRad, Eigen::Vector3d::UnitZ()) *
-      (Eigen::AngleAxisd(options.true_up_pitch_deg * kRad, Eigen::Vector3d::UnitX()) *
-       route.world_up);
+  const Eigen::Vector3d true_up_w = trueUpWorld(route, options);
   std::optional<sunfusion::SimulatedVerticalSource> vertical;
   if (options.vertical) {
     sao.vertical.enabled = true;
@@ -126,6 +123,13 @@ Expected<RunResult> runRoute(const Route& route, const std::optional<SunSourceSp
   if (!tilt) return tilt.status();
   result.tilt = *tilt;
   return result;
+}
+
+Eigen::Vector3d trueUpWorld(const Route& route, const ExperimentOptions& options) {
+  const double kRad = M_PI / 180.0;
+  return Eigen::AngleAxisd(options.true_up_roll_deg * kRad, Eigen::Vector3d::UnitZ()) *
+         (Eigen::AngleAxisd(options.true_up_pitch_deg * kRad, Eigen::Vector3d::UnitX()) *
+          route.world_up);
 }
 
 std::vector<SunSourceSpec> defaultSunSources(std::uint32_t seed) {

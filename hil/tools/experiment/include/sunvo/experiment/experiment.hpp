@@ -100,6 +100,9 @@ struct RunResult {
   metrics::Evaluation evaluation;
 };
 
+// Where the route's gravity truly is in its world: route.world_up turned by the options'
+// true_up_pitch_deg and true_up_roll_deg (what the simulated "up" measures).
+Eigen::Vector3d trueUpWorld(const Route& route, const ExperimentOptions& options);
 // The first camera pose T_w_c0 turned by a start attitude error, deg: pitch about the camera's x
 // axis, roll about its optical axis (ExperimentOptions/ReplayOptions::start_*_error_deg).
 Isometry3 withStartTiltError(const Isometry3& T_w_c0, double pitch_deg, double roll_deg);
