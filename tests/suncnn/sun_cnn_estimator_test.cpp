@@ -14,6 +14,7 @@
 #include <numbers>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <sstream>
 
 #include "../support/render_once.hpp"
@@ -192,6 +193,8 @@ TEST(SunCnnEstimator, DefaultsMatchTheShippedModelsJson) {
   EXPECT_NEAR(o.gray_sigma_scale, j.gray_sigma_scale, 5e-5) << "gray_input.sigma_scale";
   EXPECT_NEAR(o.gray_max_valid_sigma_rad, j.gray_max_valid_sigma_rad, 5e-5)
       << "gray_input.max_valid_sigma_rad";
+  EXPECT_NEAR(o.elevation_gain, j.elevation_gain, 5e-5) << "elevation_gain";
+  EXPECT_NEAR(o.gray_elevation_gain, j.gray_elevation_gain, 5e-5) << "gray_input.elevation_gain";
   EXPECT_NE(j.gray_sigma_scale, j.sigma_scale);  // the colour model has a grey calibration
   EXPECT_EQ(optionsOf(kGrayModel).input_channels, 1);
 }
@@ -252,6 +255,86 @@ TEST(SunCnnEstimator, AJsonWithoutAGreyCalibrationGivesGreyImagesTheColourOne) {
   EXPECT_DOUBLE_EQ(with->sigma_scale, 0.6);
   EXPECT_DOUBLE_EQ(with->gray_sigma_scale, 0.8);
   EXPECT_DOUBLE_EQ(with->gray_max_valid_sigma_rad, 0.55);
+}
+
+// The sun's elevation (from the prior) widens sigma: sigma = scale sqrt(raw^2 + gain tan^2 e),
+// e capped at 85 deg, nothing for a sun on or below the horizon or without a prior.
+TEST(SunCnnEstimator, TheSunsElevationWidensSigma) {
+  const HeldOutFrames& f = heldOutFrames();
+  ASSERT_FALSE(f.images.empty());
+  SunCnnOptions o = optionsOf(kModel);
+  o.elevation_gain = 0.1;  // gains of their own (the grey calibration ships with none), so that
+  o.gray_elevation_gain = 0.05;  // a sun 80 deg high is surely invalid below
+  o.sigma_min_rad = 0.0;
+  o.sigma_max_rad = 10.0;  // neither floor nor cap, so that sigma follows the formula exactly
+  const auto run = [&](const cv::Mat& img, std::optional<double> elevation_deg) {
+    SunCnnEstimator est;  // a fresh estimator each time: the same dropout masks
+    EXPECT_TRUE(est.init(o, kModel).isOk());
+    sunfusion::ImageSunInput in = inputOf(img);
+    if (elevation_deg) {
+      const double e = *elevation_deg * std::numbers::pi / 180.0, az = 0.7;
+      // Level camera (up = -y); the sun 0.7 rad to the right of the optical axis.
+      in.prior = sunfusion::SunPrior{
+          Eigen::Vector3d(std::sin(az) * std::cos(e), -std::sin(e), std::cos(az) * std::cos(e)),
+          Eigen::Vector3d(0.0, -1.0, 0.0)};
+    }
+    auto e = est.estimate(in);
+    EXPECT_TRUE(e.hasValue());
+    return std::pair{e ? *e : sunfusion::ImageSunEstimate{}, est.lastRaw()};
+  };
+  const auto tan2 = [](double deg) { return std::pow(std::tan(deg * std::numbers::pi / 180), 2); };
+  for (const cv::Mat& img : {f.images[0], grey(f.images[0])}) {
+    const double gain = img.type() == CV_8UC1 ? o.gray_elevation_gain : o.elevation_gain;
+    const auto [plain, raw0] = run(img, std::nullopt);
+    EXPECT_EQ(raw0.elevation_tan2, 0.0);
+    const double scale =
+        plain.measurement.sigma / std::sqrt(-2 * std::log(raw0.r_mc) - 2 * std::log(raw0.r_al));
+    // On the horizon or below it: nothing added.
+    EXPECT_DOUBLE_EQ(run(img, 0.0).first.measurement.sigma, plain.measurement.sigma);
+    EXPECT_DOUBLE_EQ(run(img, -10.0).first.measurement.sigma, plain.measurement.sigma);
+    for (const double deg : {20.0, 45.0, 70.0, 89.0}) {
+      const auto [e, raw] = run(img, deg);
+      const double t2 = tan2(std::min(deg, 85.0));
+      EXPECT_NEAR(raw.elevation_tan2, t2, 1e-9 * t2) << deg;
+      const double r2 = std::pow(plain.measurement.sigma / scale, 2) + gain * t2;
+      EXPECT_NEAR(e.measurement.sigma, scale * std::sqrt(r2), 1e-9) << deg;
+      EXPECT_EQ(e.azimuth_deg, plain.azimuth_deg) << "the answer itself does not change";
+    }
+    // A sun 80 deg high leaves too little of the azimuth to call the answer valid.
+    EXPECT_FALSE(run(img, 80.0).first.valid);
+  }
+  // Gain 0: the elevation changes nothing.
+  o.elevation_gain = 0.0;
+  EXPECT_DOUBLE_EQ(run(f.images[0], 60.0).first.measurement.sigma,
+                   run(f.images[0], std::nullopt).first.measurement.sigma);
+  o.elevation_gain = -0.1;
+  SunCnnEstimator bad;
+  const Status st = bad.init(o, kModel);
+  EXPECT_FALSE(st.isOk());
+  EXPECT_NE(st.message().find("suncnn.elevation_gain"), std::string::npos) << st.message();
+}
+
+// A JSON written before the elevation term (no "elevation_gain") means gain 0, for colour and
+// grey images alike; a JSON without "gray_input" gives grey images the colour gain.
+TEST(SunCnnEstimator, AJsonWithoutAnElevationGainMeansNone) {
+  const std::string dir = std::string(SUNVO_BINARY_DIR) + "/suncnn_test";
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir + "/no_gain.json")
+      << "{ \"sigma_scale\": 0.6, \"gray_input\": { \"sigma_scale\": 0.8 } }\n";
+  auto none = loadSunCnnOptions(dir + "/no_gain.json");
+  ASSERT_TRUE(none.hasValue()) << none.status().toString();
+  EXPECT_EQ(none->elevation_gain, 0.0);
+  EXPECT_EQ(none->gray_elevation_gain, 0.0);
+  std::ofstream(dir + "/colour_gain.json") << "{ \"elevation_gain\": 0.2 }\n";
+  auto colour_only = loadSunCnnOptions(dir + "/colour_gain.json");
+  ASSERT_TRUE(colour_only.hasValue()) << colour_only.status().toString();
+  EXPECT_DOUBLE_EQ(colour_only->elevation_gain, 0.2);
+  EXPECT_DOUBLE_EQ(colour_only->gray_elevation_gain, 0.2);
+  std::ofstream(dir + "/bad_gain.json") << "{ \"gray_input\": { \"elevation_gain\": 500 } }\n";
+  auto bad = loadSunCnnOptions(dir + "/bad_gain.json");
+  ASSERT_FALSE(bad.hasValue());
+  EXPECT_NE(bad.status().message().find("bad_gain.json"), std::string::npos);
+  EXPECT_NE(bad.status().message().find("gray_elevation_gain"), std::string::npos);
 }
 
 // Median azimuth error of `model` over the held-out frames, fed colour or grey images.

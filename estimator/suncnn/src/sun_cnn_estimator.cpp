@@ -15,6 +15,19 @@ Status range(const char* key, const char* r) {
   return invalidArgument(std::string("suncnn.") + key + " out of range " + r);
 }
 
+constexpr double kMaxElevationRad = 85.0 * std::numbers::pi / 180.0;
+
+// tan^2 of the sun's elevation above the plane normal to up_c, the elevation capped at 85 deg;
+// 0 for a sun on or below the horizon or a degenerate prior.
+double elevationTan2(const sunfusion::SunPrior& prior) {
+  const double n = prior.sun_c.norm() * prior.up_c.norm();
+  if (!(n > 1e-12) || !std::isfinite(n)) return 0.0;
+  const double elevation = std::asin(std::clamp(prior.sun_c.dot(prior.up_c) / n, -1.0, 1.0));
+  if (!(elevation > 0.0)) return 0.0;
+  const double t = std::tan(std::min(elevation, kMaxElevationRad));
+  return t * t;
+}
+
 // Square of the circular standard deviation of a mean resultant length R in (0, 1]: -2 ln R.
 double circularStdSquared(double r) {
   return -2.0 * std::log(std::clamp(r, 1e-6, 1.0));
@@ -45,6 +58,10 @@ Status SunCnnOptions::validate() const {
     return range("gray_sigma_scale", "(0, 100]");
   if (!(gray_max_valid_sigma_rad > 0.0 && gray_max_valid_sigma_rad <= 10.0))
     return range("gray_max_valid_sigma_rad", "(0, 10]");
+  if (!(elevation_gain >= 0.0 && elevation_gain <= 100.0))
+    return range("elevation_gain", "[0, 100]");
+  if (!(gray_elevation_gain >= 0.0 && gray_elevation_gain <= 100.0))
+    return range("gray_elevation_gain", "[0, 100]");
   if (!(max_up_tilt_deg >= 0.0 && max_up_tilt_deg <= 90.0))
     return range("max_up_tilt_deg", "[0, 90]");
   return Status::ok();
@@ -222,8 +239,11 @@ Expected<sunfusion::ImageSunEstimate> SunCnnEstimator::estimate(
   const double scale = raw.gray_calibration ? o.gray_sigma_scale : o.sigma_scale;
   const double max_valid =
       raw.gray_calibration ? o.gray_max_valid_sigma_rad : o.max_valid_sigma_rad;
+  const double gain = raw.gray_calibration ? o.gray_elevation_gain : o.elevation_gain;
+  raw.elevation_tan2 = input.prior ? elevationTan2(*input.prior) : 0.0;
   raw.sigma_rad =
-      std::clamp(scale * std::sqrt(circularStdSquared(raw.r_mc) + circularStdSquared(raw.r_al)),
+      std::clamp(scale * std::sqrt(circularStdSquared(raw.r_mc) + circularStdSquared(raw.r_al) +
+                                   gain * raw.elevation_tan2),
                  o.sigma_min_rad, o.sigma_max_rad);
   raw_ = raw;
 

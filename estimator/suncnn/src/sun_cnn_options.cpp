@@ -79,15 +79,22 @@ Expected<SunCnnOptions> loadSunCnnOptions(const std::string& json_path, const Su
     num(mc, "dropout_p", "mc.dropout_p", o.dropout_p);
     num(root, "sigma_scale", "sigma_scale", o.sigma_scale);
     num(root, "max_valid_sigma_rad", "max_valid_sigma_rad", o.max_valid_sigma_rad);
+    // A JSON without the elevation gain was calibrated without the elevation term: gain 0.
+    o.elevation_gain = 0.0;
+    num(root, "elevation_gain", "elevation_gain", o.elevation_gain);
     // Grey images on a colour model: their own calibration where the JSON has one, else the
     // colour calibration (a model calibrated before grey inputs had their own numbers).
     const YAML::Node gray = section("gray_input");
     if (gray.size() == 0) {
       o.gray_sigma_scale = o.sigma_scale;
       o.gray_max_valid_sigma_rad = o.max_valid_sigma_rad;
+      o.gray_elevation_gain = o.elevation_gain;
+    } else {
+      o.gray_elevation_gain = 0.0;
     }
     num(gray, "sigma_scale", "gray_input.sigma_scale", o.gray_sigma_scale);
     num(gray, "max_valid_sigma_rad", "gray_input.max_valid_sigma_rad", o.gray_max_valid_sigma_rad);
+    num(gray, "elevation_gain", "gray_input.elevation_gain", o.gray_elevation_gain);
   } catch (const YAML::Exception& e) {
     return parseError("suncnn: " + json_path + ": " + e.what());
   }

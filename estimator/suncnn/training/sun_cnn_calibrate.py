@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Re-chooses an exported Sun-CNN's validity threshold and sigma scale on the manifest's
-validation rows, without retraining, and rewrites the model's JSON (sigma_scale,
-max_valid_sigma_rad, results per split). The model runs through OpenCV's DNN, as in C++:
+validation rows, without retraining, and rewrites the model's JSON (elevation_gain, sigma_scale,
+max_valid_sigma_rad, results per split; sun_cnn_model.calibrate_elevation). The model runs through OpenCV's DNN, as in C++:
 image -> INTER_AREA resize -> planes -> 16 MC mask rows per member (numpy masks).
 
     sun_cnn_calibrate.py --manifest /work/renders/sun_cnn_manifest.csv --model config/sun_cnn.onnx
@@ -18,7 +18,8 @@ import sys
 import cv2
 import numpy as np
 
-from sun_cnn_model import DROPOUT_P, IN_H, IN_W, MEAN, STD, calibrate, combine
+from sun_cnn_model import (DROPOUT_P, IN_H, IN_W, MEAN, STD, calibrate_elevation, combine,
+                           elevation_tan2, with_elevation)
 from sun_cnn_train import LUMA, load, report, signed_deg, targets
 
 SAMPLES = 16
@@ -77,18 +78,21 @@ def main():
             t, w = targets(sun)
             keep = w > 0
             v, raw = combine(*run_model(net, meta, x[keep], rng, grey_in))
-            evals[split] = (signed_deg(v, t[keep]), raw, np.array(scen)[keep])
-        scale, threshold = calibrate(evals["val"][0], evals["val"][1])
-        return scale, threshold, {k: report(e, r, s, scale, threshold)
-                                  for k, (e, r, s) in evals.items()}
+            evals[split] = (signed_deg(v, t[keep]), raw, np.array(scen)[keep],
+                            elevation_tan2(sun[keep]))
+        gain, scale, threshold = calibrate_elevation(*[evals["val"][i] for i in (0, 1, 3)])
+        return gain, scale, threshold, {
+            k: report(e, with_elevation(r, t2, gain), s, scale, threshold)
+            for k, (e, r, s, t2) in evals.items()}
 
     if a.grey_only and meta["input"]["channels"] != 3:
         raise SystemExit(f"{a.model}: --grey-only needs a colour model")
     if not a.grey_only:
         # Validation first: the masks it draws do not depend on the other rows listed.
-        scale, threshold, scored = calibrated(
+        gain, scale, threshold, scored = calibrated(
             False, ["val"] + [k for k in data if k != "val"], rng)
         meta["sigma_scale"], meta["max_valid_sigma_rad"] = scale, threshold
+        meta["elevation_gain"] = gain
         # A split the manifest does not list (e.g. the training renders, not at hand) keeps its
         # old scores, under a name that says they belong to the previous calibration.
         old = {**meta.pop("results_previous_calibration", {}), **meta.get("results", {})}
@@ -99,13 +103,15 @@ def main():
     if meta["input"]["channels"] == 3:
         # Grey cameras fed to this colour model as (Y, Y, Y): their own threshold and scale, with
         # masks of their own, validation first (the same whatever other rows the manifest lists).
-        g_scale, g_threshold, g_results = calibrated(
+        g_gain, g_scale, g_threshold, g_results = calibrated(
             True, ["val"] + [k for k in data if k not in ("train", "val")],
             np.random.default_rng([a.seed, 1]))
         meta["gray_input"] = {"sigma_scale": g_scale, "max_valid_sigma_rad": g_threshold,
-                              "results": g_results}
-    meta["calibration"] = ("sun_cnn_calibrate.py: threshold flags 90 % of the validation gross "
-                           "errors; scale puts 95 % of the valid validation frames within 2 sigma")
+                              "elevation_gain": g_gain, "results": g_results}
+    meta["calibration"] = ("sun_cnn_calibrate.py: raw' = sqrt(raw^2 + elevation_gain tan^2(sun "
+                           "elevation)), the gain leaving the most validation frames valid; "
+                           "threshold flags 90 % of the validation gross errors; scale puts 95 % "
+                           "of the valid validation frames within 2 sigma")
     with open(json_path, "w") as f:
         json.dump(meta, f, indent=2)
         f.write("\n")
@@ -116,11 +122,13 @@ def main():
               f"valid {100 * m['valid_share']:.0f} %, gross flagged "
               f"{100 * m.get('gross_flagged_share', float('nan')):.0f} %, within 2 sigma "
               f"{100 * m.get('within_2sigma_share', float('nan')):.0f} %", file=sys.stderr)
-    print(f"{json_path}: sigma_scale {meta['sigma_scale']:.4f}, max_valid_sigma_rad "
-          f"{meta['max_valid_sigma_rad']:.4f}", file=sys.stderr)
+    print(f"{json_path}: elevation_gain {meta.get('elevation_gain', 0.0):g}, sigma_scale "
+          f"{meta['sigma_scale']:.4f}, max_valid_sigma_rad {meta['max_valid_sigma_rad']:.4f}",
+          file=sys.stderr)
     if "gray_input" in meta:
         g = meta["gray_input"]
-        print(f"{json_path}: grey input: sigma_scale {g['sigma_scale']:.4f}, max_valid_sigma_rad "
+        print(f"{json_path}: grey input: elevation_gain {g['elevation_gain']:g}, sigma_scale "
+              f"{g['sigma_scale']:.4f}, max_valid_sigma_rad "
               f"{g['max_valid_sigma_rad']:.4f}", file=sys.stderr)
 
 

@@ -102,17 +102,67 @@ def combine(dets, samps):
     return v, np.sqrt(-2 * np.log(r_mc) - 2 * np.log(r_al))
 
 
-def calibrate(err_deg, raw):
+def calibrate(err_deg, raw, tan2=None):
     """The validity threshold and the sigma scale, from validation errors (deg) and raw sigmas
     (rad). The threshold on raw sigma flags 90 % of the gross (> 45 deg) errors (the 10th
     percentile of raw sigma over them; with fewer than 5 gross errors no frame is flagged).
+    Given tan2 (elevation_tan2 of the frames), it flags 90 % of them in every sun-elevation band
+    (ELEVATION_BANDS_DEG) that holds at least 10 (the lowest band threshold), so that the rule
+    does not depend on how the validation drives mix high and low suns.
     The scale then makes 95 % of the frames below it fall within 2 sigma, i.e. sigma is
     calibrated on the frames the estimator calls valid, which are the ones the fusion sees.
     Returns (scale, threshold on the scaled sigma in rad)."""
     gross = np.abs(err_deg) > 45
     tau = np.percentile(raw[gross], 10) if gross.sum() >= 5 else np.inf
+    if tan2 is not None:
+        band = np.digitize(np.degrees(np.arctan(np.sqrt(tan2))), ELEVATION_BANDS_DEG[1:-1])
+        taus = [np.percentile(raw[gross & (band == b)], 10) for b in np.unique(band)
+                if (gross & (band == b)).sum() >= 10]
+        if taus:
+            tau = min(taus)
     valid = raw <= tau
     if valid.sum() < 5:
         valid = np.ones_like(valid)
     scale = float(np.percentile(np.radians(np.abs(err_deg[valid])) / raw[valid], 95) / 2.0)
     return scale, float(min(scale * tau, 3.0))
+
+
+# The sun's elevation as a second uncertainty signal. The higher the sun, the shorter the shadows
+# and the more even the sky around the horizon: the image says less about the azimuth, and the
+# network's spread does not fully know it (validation, 2026-12-02: 9 % gross errors below 30 deg
+# of elevation, 62 % above 75 deg; docs/sun_cnn_calibration.md). The raw sigma becomes
+#     raw' = sqrt(raw^2 + gain tan^2(min(elevation, 85 deg)))   (0 for a sun below the horizon),
+# the elevation being the ephemeris's (the C++ estimator takes it from its prior, sun_c . up_c).
+ELEVATION_CAP_DEG = 85.0
+ELEVATION_GAINS = (0.0, 0.003, 0.01, 0.03, 0.1, 0.3, 1.0)
+ELEVATION_BANDS_DEG = (0.0, 30.0, 45.0, 60.0, 90.0)  # calibrate(): 90 % flagged in each
+
+
+def elevation_tan2(sun_cam):
+    """tan^2 of the sun's elevation, capped at 85 deg, 0 below the horizon, from camera-frame sun
+    vectors (y down). The camera's tilt from level (a few degrees on the rendered drives) is
+    neglected here; the C++ estimator uses the true horizontal plane."""
+    s = np.asarray(sun_cam, np.float64)
+    sin_el = np.clip(-s[:, 1] / np.maximum(np.linalg.norm(s, axis=1), 1e-12), -1.0, 1.0)
+    el = np.minimum(np.arcsin(sin_el), np.radians(ELEVATION_CAP_DEG))
+    return np.where(el > 0, np.tan(np.maximum(el, 0.0)) ** 2, 0.0)
+
+
+def with_elevation(raw, tan2, gain):
+    return np.sqrt(raw ** 2 + gain * tan2)
+
+
+def calibrate_elevation(err_deg, raw, tan2):
+    """The elevation gain, then calibrate() on raw' with the elevation bands: the gain in
+    ELEVATION_GAINS whose threshold (still flagging 90 % of the validation gross errors in every
+    band) leaves the most validation frames valid; the smallest such gain on a tie. Returns
+    (gain, scale, threshold)."""
+    best = None
+    for gain in ELEVATION_GAINS:
+        r = with_elevation(raw, tan2, gain)
+        scale, threshold = calibrate(err_deg, r, tan2)
+        valid = float(np.mean(np.clip(scale * r, 0.03, 3.0) <= threshold))
+        if best is None or valid > best[0] + 1e-12:
+            best = (valid, gain, scale, threshold)
+    return best[1], best[2], best[3]
+

@@ -34,7 +34,8 @@ import numpy as np
 import torch
 
 from sun_cnn_model import (DROPOUT_P, FEAT, HIDDEN, IN_H, IN_W, K_ROWS, MEAN, STD, EnsembleExport,
-                           SunCnn, calibrate, combine, mc_predict)
+                           SunCnn, calibrate_elevation, combine, elevation_tan2, mc_predict,
+                           with_elevation)
 
 LOAD_W, LOAD_H = 2 * IN_W, 2 * IN_H  # images are kept at twice the input size for the crops
 LUMA = np.array([0.114, 0.587, 0.299], np.float32)  # BT.601, BGR order
@@ -196,7 +197,7 @@ def evaluate(members, split, channels, seed):
     keep = w > 0
     dets, samps = mc_predict(members, plain(x, channels), 16, torch.Generator().manual_seed(seed))
     v, raw = combine(dets, samps)
-    return signed_deg(v, t)[keep], raw[keep], np.array(scen)[keep]
+    return signed_deg(v, t)[keep], raw[keep], np.array(scen)[keep], elevation_tan2(sun[keep])
 
 
 def report(err, raw, scen, scale, threshold):
@@ -299,26 +300,28 @@ def main():
         torch.save({"members": [m.state_dict() for m in members], "channels": a.channels,
                     "epochs": a.epochs, "train_seconds": train_s}, a.save_members)
 
-    # Choices on the validation rows only: the validity threshold and the sigma scale
-    # (sun_cnn_model.calibrate).
-    scale, threshold, results = 1.0, 0.5, {}
+    # Choices on the validation rows only: the elevation gain, the validity threshold and the
+    # sigma scale (sun_cnn_model.calibrate_elevation).
+    gain, scale, threshold, results = 0.0, 1.0, 0.5, {}
     if "val" in data:
-        err, raw, scen = evaluate(members, data["val"], a.channels, a.seed)
-        scale, threshold = calibrate(err, raw)
-        results["val"] = report(err, raw, scen, scale, threshold)
+        err, raw, scen, tan2 = evaluate(members, data["val"], a.channels, a.seed)
+        gain, scale, threshold = calibrate_elevation(err, raw, tan2)
+        results["val"] = report(err, with_elevation(raw, tan2, gain), scen, scale, threshold)
     for split in ("train", "test"):
         if split in data:
-            err, raw, scen = evaluate(members, data[split], a.channels, a.seed)
-            results[split] = report(err, raw, scen, scale, threshold)
+            err, raw, scen, tan2 = evaluate(members, data[split], a.channels, a.seed)
+            results[split] = report(err, with_elevation(raw, tan2, gain), scen, scale, threshold)
     # A colour model also serves grey cameras, fed (Y, Y, Y): their answers get their own
     # threshold and scale, chosen the same way on the validation rows' luma.
     gray_input = {}
     if a.channels == 3 and "val" in data:
         g_evals = {k: evaluate(members, (grey_as_colour(data[k][0]),) + data[k][1:], 3, a.seed)
                    for k in ("val", "test") if k in data}
-        g_scale, g_threshold = calibrate(*g_evals["val"][:2])
+        g_gain, g_scale, g_threshold = calibrate_elevation(*g_evals["val"][:2], g_evals["val"][3])
         gray_input = {"sigma_scale": g_scale, "max_valid_sigma_rad": g_threshold,
-                      "results": {k: report(*e, g_scale, g_threshold) for k, e in g_evals.items()}}
+                      "elevation_gain": g_gain,
+                      "results": {k: report(e, with_elevation(r, t2, g_gain), s, g_scale,
+                                            g_threshold) for k, (e, r, s, t2) in g_evals.items()}}
     for split, r in list(results.items()) + [
             ("grey " + k, v) for k, v in gray_input.get("results", {}).items()]:
         for scenario, m in r.items():
@@ -350,6 +353,7 @@ def main():
         "output": "[members * rows, 2]: (cos az, sin az), az = atan2(sun_x, sun_z) in camera 0",
         "sigma_scale": scale,
         "max_valid_sigma_rad": threshold,
+        "elevation_gain": gain,
         "training_data_sha256": data_hash,
         "training_images": int(len(xtr)),
         "training_command": "bash scripts/train_sun_cnn.sh",

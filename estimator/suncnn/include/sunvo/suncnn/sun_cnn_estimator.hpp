@@ -24,8 +24,13 @@
 //   R_al = |v|  (data ambiguity: each net is trained with the squared chord loss, whose
 //          minimiser is E[(cos az, sin az) | image], so an image with no sun cue is answered
 //          with a short vector; members that disagree shorten the mean as well)
-//   sigma = clamp(sigma_scale * sqrt(-2 ln R_mc - 2 ln R_al), sigma_min_rad, sigma_max_rad)
-// sigma_scale and max_valid_sigma_rad are chosen on the validation renders (held-out styles).
+// and a third term from the sun's elevation e, known from the ephemeris (the prior: sin e =
+// sun_c . up_c): the higher the sun, the shorter the shadows and the less the image says about
+// its azimuth, which the spread alone misses (docs/sun_cnn_calibration.md):
+//   sigma = clamp(sigma_scale * sqrt(-2 ln R_mc - 2 ln R_al + elevation_gain tan^2 e'),
+//                 sigma_min_rad, sigma_max_rad),   e' = min(e, 85 deg), tan e' = 0 for e <= 0
+// (no prior: no elevation term). elevation_gain, sigma_scale and max_valid_sigma_rad are chosen
+// on the validation renders (held-out styles).
 //
 // The library opens no file but the model, and only when init() is given a path.
 
@@ -53,11 +58,11 @@ struct SunCnnOptions {
   int mask2_size = 128;         // D, hidden units into the second FC layer, must match, [1, 1e6]
   double dropout_p = 0.3;       // dropout probability used in training, [0, 0.9]
   int mc_samples = 16;          // N, MC dropout samples per image, [0, mask_rows - 1]; 0: R_mc = 1
-  double sigma_scale = 0.8341;  // calibration factor on the spread sigma, (0, 100]; fitted
+  double sigma_scale = 0.6735;  // calibration factor on the spread sigma, (0, 100]; fitted
                                 // on the validation renders (config/sun_cnn.json)
   double sigma_min_rad = 0.03;  // floor of the reported sigma, rad, [0, 1]
   double sigma_max_rad = 3.0;   // cap of the reported sigma, rad, [sigma_min_rad, 10]
-  double max_valid_sigma_rad = 0.5869;  // above this the estimate is returned with
+  double max_valid_sigma_rad = 0.4954;  // above this the estimate is returned with
                                         // valid = false, rad, (0, 10]; chosen on the validation
                                         // renders (config/sun_cnn.json)
   // The same two numbers for a grey image fed to a colour model as (Y, Y, Y) (grey V4L2 or
@@ -65,8 +70,13 @@ struct SunCnnOptions {
   // their own calibration, chosen on the validation renders' grey luma (config/sun_cnn.json,
   // "gray_input"). A JSON without that section gives them the colour values. Unused by a grey
   // model (input_channels 1).
-  double gray_sigma_scale = 0.8073;          // (0, 100]
-  double gray_max_valid_sigma_rad = 0.6505;  // rad, (0, 10]
+  double gray_sigma_scale = 0.7983;          // (0, 100]
+  double gray_max_valid_sigma_rad = 0.6352;  // rad, (0, 10]
+  // Weight of tan^2 of the sun's elevation in the squared raw spread (header comment), rad^2,
+  // [0, 100]; 0: off. The JSON's "elevation_gain" (and gray_input's for grey images); a JSON
+  // without the key was calibrated without the term, so it means 0.
+  double elevation_gain = 0.01;
+  double gray_elevation_gain = 0.0;
   double max_up_tilt_deg = 30.0;  // valid = false when the prior's "up" is further than this
                                   // from the camera's -y (the azimuth is in the x-z plane), deg,
                                   // [0, 90]; ignored without a prior
@@ -75,8 +85,8 @@ struct SunCnnOptions {
 };
 
 // The JSON the training script writes beside a model (<model>.json): the input size and
-// channels, ensemble members, mask sizes, dropout, sigma_scale and max_valid_sigma_rad (and for
-// a colour model gray_input.sigma_scale and gray_input.max_valid_sigma_rad), over
+// channels, ensemble members, mask sizes, dropout, sigma_scale, max_valid_sigma_rad and
+// elevation_gain (and for a colour model gray_input's three), over
 // `base` (keys it lacks keep base's values). Errors name the file and the key.
 Expected<SunCnnOptions> loadSunCnnOptions(const std::string& json_path,
                                           const SunCnnOptions& base = {});
@@ -91,6 +101,8 @@ struct SunCnnRaw {
   double c = 0.0, s = 0.0;        // deterministic output (dropout off)
   double r_mc = 1.0;              // mean resultant length of the MC sample directions, [0, 1]
   double r_al = 0.0;              // length of the deterministic output, clamped to [0, 1]
+  double elevation_tan2 = 0.0;    // tan^2 of the prior's sun elevation (capped at 85 deg), 0
+                                  // below the horizon or without a prior
   double sigma_rad = 0.0;         // after scale and clamp
   bool gray_calibration = false;  // a grey image on a colour model: the gray_* numbers applied
 };
