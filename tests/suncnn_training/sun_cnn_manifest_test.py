@@ -241,9 +241,13 @@ class EndToEnd(Base):
         model = os.path.join(model_dir, "sun_cnn.onnx")
         self.assertGreater(os.path.getsize(model), 1000)
         with open(os.path.join(model_dir, "sun_cnn.json")) as f:
-            grey = json.load(f)["gray_input"]  # a colour model's calibration for grey cameras
+            meta = json.load(f)
+        grey = meta["gray_input"]  # a colour model's calibration for grey cameras
         self.assertGreater(grey["sigma_scale"], 0.0)
         self.assertIn("val", grey["results"])
+        # The sun-elevation gain (sun_cnn_model.calibrate_elevation), one of its grid, per input.
+        for gain in (meta["elevation_gain"], grey["elevation_gain"]):
+            self.assertIn(gain, (0.0, 0.003, 0.01, 0.03, 0.1, 0.3, 1.0))
         # sun_cnn_calibrate.py --grey-only re-chooses the grey numbers and keeps the colour ones.
         with open(os.path.join(model_dir, "sun_cnn.json")) as f:
             before = json.load(f)
@@ -252,10 +256,10 @@ class EndToEnd(Base):
                             "--manifest", manifest, "--model", model, "--grey-only"],
                            capture_output=True, text=True)
         self.assertEqual(p.returncode, 0, p.stderr)
-        self.assertIn("grey input: sigma_scale", p.stderr)
+        self.assertIn("grey input: elevation_gain", p.stderr)
         with open(os.path.join(model_dir, "sun_cnn.json")) as f:
             after = json.load(f)
-        for key in ("sigma_scale", "max_valid_sigma_rad", "results"):
+        for key in ("sigma_scale", "max_valid_sigma_rad", "elevation_gain", "results"):
             self.assertEqual(after[key], before[key], key)
         self.assertGreater(after["gray_input"]["sigma_scale"], 0.0)
         # A full re-calibration on a manifest without the training rows: the training split keeps
@@ -279,6 +283,35 @@ class EndToEnd(Base):
         self.assertEqual(p.returncode, 0, p.stderr)
         set_name = os.path.basename(os.path.normpath(ARGS.frames))
         self.assertIn(f"| sun_cnn | {set_name} | 11 |", p.stdout)
+
+    def test_uncertainty_signals_run_on_the_shipped_model(self):
+        """sun_cnn_signals.py (the flip/gamma views and the sun's elevation, docs/
+        sun_cnn_calibration.md) on the real frames as validation (0-5) and test (6-10) rows: one
+        row per view and gain, the ranking table and three calibrations per split."""
+        if not ARGS.trainer:
+            self.skipTest("needs --trainer")
+        with open(ARGS.sun_csv) as f:
+            lines = f.read().splitlines()
+        args = []
+        for split, part in {"val": lines[0:7], "test": [lines[0]] + lines[7:12]}.items():
+            path = os.path.join(self.work, f"signals_{split}.csv")
+            with open(path, "w") as f:
+                f.write("\n".join(part) + "\n")
+            args += ["--real", f"{ARGS.frames}:{path}:{split}"]
+        manifest, _ = self.manifest(*args)
+        tools = os.path.dirname(os.path.abspath(ARGS.trainer))
+        model = os.path.join(tools, "..", "..", "..", "config", "sun_cnn.onnx")
+        table = os.path.join(self.work, "signals.md")
+        p = subprocess.run([sys.executable, os.path.join(tools, "sun_cnn_signals.py"), "--manifest",
+                            manifest, "--model", model, "--out", table],
+                           capture_output=True, text=True)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        with open(table) as f:
+            text = f.read()
+        self.assertEqual(text.count("\n| flip |"), 5)
+        self.assertEqual(text.count("\n| plain | 0 |"), 1)
+        self.assertEqual(text.count("\n| val | "), 1 + 3)  # the ranking row, three calibrations
+        self.assertEqual(text.count("\n| test | "), 1 + 3)
 
     def test_members_trained_apart_join_into_the_same_ensemble(self):
         """Two members trained in two processes (--first-member, --save-members) and joined with
