@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """Re-chooses an exported Sun-CNN's validity threshold and sigma scale on the manifest's
 validation rows, without retraining, and rewrites the model's JSON (elevation_gain, sigma_scale,
-max_valid_sigma_rad, results per split; sun_cnn_model.calibrate_elevation). The model runs through OpenCV's DNN, as in C++:
-image -> INTER_AREA resize -> planes -> 16 MC mask rows per member (numpy masks).
+max_valid_sigma_rad, results per split; sun_cnn_model.calibrate_elevation). The model runs
+through OpenCV's DNN, as in C++: image -> INTER_AREA resize -> planes -> 16 MC mask rows per
+member (numpy masks).
 
     sun_cnn_calibrate.py --manifest /work/renders/sun_cnn_manifest.csv --model config/sun_cnn.onnx
 
@@ -110,8 +111,9 @@ def main():
                               "elevation_gain": g_gain, "results": g_results}
     meta["calibration"] = ("sun_cnn_calibrate.py: raw' = sqrt(raw^2 + elevation_gain tan^2(sun "
                            "elevation)), the gain leaving the most validation frames valid; "
-                           "threshold flags 90 % of the validation gross errors; scale puts 95 % "
-                           "of the valid validation frames within 2 sigma")
+                           "threshold flags 90 % of the validation gross errors in every elevation "
+                           "band holding >= 10 of them; scale puts 95 % of the valid validation "
+                           "frames within 2 sigma")
     with open(json_path, "w") as f:
         json.dump(meta, f, indent=2)
         f.write("\n")

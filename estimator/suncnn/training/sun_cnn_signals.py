@@ -71,8 +71,9 @@ def pct(x):
 
 
 def view_rows(per):
-    rows = ["| view | k | val valid | val median (valid) | val gross flagged | val 2σ | test valid | "
-            "test median (valid) | test gross (valid) | test gross flagged | test 2σ |",
+    rows = ["| view | k | val valid | val median (valid) | val gross flagged | val 2σ | "
+            "test valid | test median (valid) | test gross (valid) | test gross flagged | "
+            "test 2σ |",
             "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
     for view in ("flip", "gamma", "both"):
         for k in KS:
@@ -84,11 +85,13 @@ def view_rows(per):
                       for s in ("val", "test"))
             rows.append(
                 f"| {'plain' if k == 0 else view} | {k:g} | {pct(mv['valid_share'])} | "
-                f"{mv.get('valid_median_deg', NAN):.1f}° | {pct(mv.get('gross_flagged_share', NAN))} | "
+                f"{mv.get('valid_median_deg', NAN):.1f}° | "
+                f"{pct(mv.get('gross_flagged_share', NAN))} | "
                 f"{pct(mv.get('within_2sigma_share', NAN))} | {pct(mt['valid_share'])} | "
                 f"{mt.get('valid_median_deg', NAN):.1f}° | "
                 f"{100 * mt.get('valid_gross_share', NAN):.1f} % | "
-                f"{pct(mt.get('gross_flagged_share', NAN))} | {pct(mt.get('within_2sigma_share', NAN))} |")
+                f"{pct(mt.get('gross_flagged_share', NAN))} | "
+                f"{pct(mt.get('within_2sigma_share', NAN))} |")
     return rows
 
 
@@ -102,7 +105,8 @@ def ranking_rows(per):
                     " | ".join(f"{auc(p[k], bad):.3f}" for k in ("raw", "flip", "gamma", "both",
                                                                  "tan2")) +
                     f" | {np.corrcoef(p['raw'], p['flip'])[0, 1]:.2f} | "
-                    f"{np.median(np.abs(p['err'])):.1f}° / {np.median(np.abs(p['err_avg'])):.1f}° | "
+                    f"{np.median(np.abs(p['err'])):.1f}° / "
+                    f"{np.median(np.abs(p['err_avg'])):.1f}° | "
                     f"{100 * bad.mean():.1f} / {100 * (np.abs(p['err_avg']) > 45).mean():.1f} % |")
     return rows
 
@@ -117,7 +121,8 @@ def band_rows(per):
              (f"spread + elevation (gain {gain:g}), per-band rule", gain, e_scale, e_thr)]
     edges = ELEVATION_BANDS_DEG
     head = " | ".join(f"{edges[b]:g}–{edges[b + 1]:g}°" for b in range(len(edges) - 1))
-    rows = [f"| set | calibration | all | {head} |", "| --- | --- | --- |" + " --- |" * (len(edges) - 1)]
+    rows = [f"| set | calibration | all | {head} |",
+            "| --- | --- | --- |" + " --- |" * (len(edges) - 1)]
     for s, p in per.items():
         band = np.digitize(np.degrees(np.arctan(np.sqrt(p["tan2"]))), edges[1:-1])
         err = np.abs(p["err"])
@@ -144,7 +149,8 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--manifest", required=True)
     ap.add_argument("--model", required=True)
-    ap.add_argument("--grey", action="store_true", help="feed the images as a grey camera, (Y, Y, Y)")
+    ap.add_argument("--grey", action="store_true",
+                    help="feed the images as a grey camera, (Y, Y, Y)")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--out", help="also write the tables (markdown) here")
     a = ap.parse_args()
