@@ -81,7 +81,8 @@ def main():
             v, raw = combine(*run_model(net, meta, x[keep], rng, grey_in))
             evals[split] = (signed_deg(v, t[keep]), raw, np.array(scen)[keep],
                             elevation_tan2(sun[keep]))
-        gain, scale, threshold = calibrate_elevation(*[evals["val"][i] for i in (0, 1, 3)])
+        val_err, val_raw, _, val_tan2 = evals["val"]
+        gain, scale, threshold = calibrate_elevation(val_err, val_raw, val_tan2)
         return gain, scale, threshold, {
             k: report(e, with_elevation(r, t2, gain), s, scale, threshold)
             for k, (e, r, s, t2) in evals.items()}

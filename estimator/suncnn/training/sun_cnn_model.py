@@ -102,6 +102,17 @@ def combine(dets, samps):
     return v, np.sqrt(-2 * np.log(r_mc) - 2 * np.log(r_al))
 
 
+def sigma_of(raw, scale):
+    """The reported sigma (rad) of raw spreads: scaled and clamped to [0.03, 3], as SunCnnOptions'
+    sigma_min_rad / sigma_max_rad do in C++."""
+    return np.clip(scale * raw, 0.03, 3.0)
+
+
+def elevation_band(tan2):
+    """Index of each frame's sun-elevation band in ELEVATION_BANDS_DEG (from elevation_tan2)."""
+    return np.digitize(np.degrees(np.arctan(np.sqrt(tan2))), ELEVATION_BANDS_DEG[1:-1])
+
+
 def calibrate(err_deg, raw, tan2=None):
     """The validity threshold and the sigma scale, from validation errors (deg) and raw sigmas
     (rad). The threshold on raw sigma flags 90 % of the gross (> 45 deg) errors (the 10th
@@ -115,7 +126,7 @@ def calibrate(err_deg, raw, tan2=None):
     gross = np.abs(err_deg) > 45
     tau = np.percentile(raw[gross], 10) if gross.sum() >= 5 else np.inf
     if tan2 is not None:
-        band = np.digitize(np.degrees(np.arctan(np.sqrt(tan2))), ELEVATION_BANDS_DEG[1:-1])
+        band = elevation_band(tan2)
         taus = [np.percentile(raw[gross & (band == b)], 10) for b in np.unique(band)
                 if (gross & (band == b)).sum() >= 10]
         if taus:
@@ -161,7 +172,7 @@ def calibrate_elevation(err_deg, raw, tan2):
     for gain in ELEVATION_GAINS:
         r = with_elevation(raw, tan2, gain)
         scale, threshold = calibrate(err_deg, r, tan2)
-        valid = float(np.mean(np.clip(scale * r, 0.03, 3.0) <= threshold))
+        valid = float(np.mean(sigma_of(r, scale) <= threshold))
         if best is None or valid > best[0] + 1e-12:
             best = (valid, gain, scale, threshold)
     return best[1], best[2], best[3]

@@ -29,7 +29,7 @@ import numpy as np
 
 from sun_cnn_calibrate import run_model
 from sun_cnn_model import (ELEVATION_BANDS_DEG, calibrate, calibrate_elevation, combine,
-                           elevation_tan2, with_elevation)
+                           elevation_band, elevation_tan2, sigma_of, with_elevation)
 from sun_cnn_train import grey_as_colour, load, report, signed_deg, targets
 
 KS = (0.0, 0.25, 0.5, 1.0, 2.0, 4.0)
@@ -124,10 +124,10 @@ def band_rows(per):
     rows = [f"| set | calibration | all | {head} |",
             "| --- | --- | --- |" + " --- |" * (len(edges) - 1)]
     for s, p in per.items():
-        band = np.digitize(np.degrees(np.arctan(np.sqrt(p["tan2"]))), edges[1:-1])
+        band = elevation_band(p["tan2"])
         err = np.abs(p["err"])
         for name, g, scale, thr in rules:
-            sigma = np.clip(scale * with_elevation(p["raw"], p["tan2"], g), 0.03, 3.0)
+            sigma = sigma_of(with_elevation(p["raw"], p["tan2"], g), scale)
             valid = sigma <= thr
 
             def cell(m):

@@ -35,7 +35,7 @@ import torch
 
 from sun_cnn_model import (DROPOUT_P, FEAT, HIDDEN, IN_H, IN_W, K_ROWS, MEAN, STD, EnsembleExport,
                            SunCnn, calibrate_elevation, combine, elevation_tan2, mc_predict,
-                           with_elevation)
+                           sigma_of, with_elevation)
 
 LOAD_W, LOAD_H = 2 * IN_W, 2 * IN_H  # images are kept at twice the input size for the crops
 LUMA = np.array([0.114, 0.587, 0.299], np.float32)  # BT.601, BGR order
@@ -201,7 +201,7 @@ def evaluate(members, split, channels, seed):
 
 
 def report(err, raw, scen, scale, threshold):
-    sigma = np.clip(scale * raw, 0.03, 3.0)
+    sigma = sigma_of(raw, scale)
     valid = sigma <= threshold
     out = {"all": metrics(err, sigma, valid)}
     for s in sorted(set(scen)):
@@ -317,7 +317,8 @@ def main():
     if a.channels == 3 and "val" in data:
         g_evals = {k: evaluate(members, (grey_as_colour(data[k][0]),) + data[k][1:], 3, a.seed)
                    for k in ("val", "test") if k in data}
-        g_gain, g_scale, g_threshold = calibrate_elevation(*g_evals["val"][:2], g_evals["val"][3])
+        g_err, g_raw, _, g_tan2 = g_evals["val"]
+        g_gain, g_scale, g_threshold = calibrate_elevation(g_err, g_raw, g_tan2)
         gray_input = {"sigma_scale": g_scale, "max_valid_sigma_rad": g_threshold,
                       "elevation_gain": g_gain,
                       "results": {k: report(e, with_elevation(r, t2, g_gain), s, g_scale,
