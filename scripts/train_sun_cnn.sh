@@ -88,4 +88,10 @@ done
 status=0
 for p in "${pids[@]}"; do wait "$p" || status=1; done
 tail -n 25 "$RENDERS"/train_sun_cnn*.log
-exit "$status"
+[ "$status" = 0 ] || exit "$status"
+# The feature term (its prior is fitted on the manifest's training rows) and the numbers that go
+# with it, chosen on the validation rows as in training (docs/sun_cnn_calibration.md).
+for name in sun_cnn sun_cnn_gray; do
+  (cd "$ROOT/estimator/suncnn/training" && "$PY" sun_cnn_calibrate.py \
+    --manifest "$RENDERS/sun_cnn_manifest.csv" --model "$ROOT/config/$name.onnx") || exit 1
+done

@@ -267,6 +267,7 @@ TEST(SunCnnEstimator, TheSunsElevationWidensSigma) {
   o.gray_elevation_gain = 0.05;  // a sun 80 deg high is surely invalid below
   o.sigma_min_rad = 0.0;
   o.sigma_max_rad = 10.0;  // neither floor nor cap, so that sigma follows the formula exactly
+  o.feature_gain = o.gray_feature_gain = 0.0;  // the spread alone under the root (features_test)
   const auto run = [&](const cv::Mat& img, std::optional<double> elevation_deg) {
     SunCnnEstimator est;  // a fresh estimator each time: the same dropout masks
     EXPECT_TRUE(est.init(o, kModel).isOk());

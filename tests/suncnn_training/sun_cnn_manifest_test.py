@@ -313,6 +313,39 @@ class EndToEnd(Base):
         self.assertEqual(text.count("\n| val | "), 1 + 3)  # the ranking row, three calibrations
         self.assertEqual(text.count("\n| test | "), 1 + 3)
 
+    def test_feature_distance_study_runs_on_the_shipped_model(self):
+        """sun_cnn_ood.py (the trunk features' distance from the training images', docs/
+        sun_cnn_calibration.md) on the real frames as training (0-3), validation (4-7) and test
+        (8-10) rows: a distance row per split and real folder, the AUC rows, and one calibration
+        row per signal, form and gain."""
+        if not ARGS.trainer:
+            self.skipTest("needs --trainer")
+        with open(ARGS.sun_csv) as f:
+            lines = f.read().splitlines()
+        args = []
+        for split, part in {"train": lines[0:5], "val": [lines[0]] + lines[5:9],
+                            "test": [lines[0]] + lines[9:12]}.items():
+            path = os.path.join(self.work, f"ood_{split}.csv")
+            with open(path, "w") as f:
+                f.write("\n".join(part) + "\n")
+            args += ["--real", f"{ARGS.frames}:{path}:{split}"]
+        manifest, _ = self.manifest(*args)
+        tools = os.path.dirname(os.path.abspath(ARGS.trainer))
+        model = os.path.join(tools, "..", "..", "..", "config", "sun_cnn.onnx")
+        table = os.path.join(self.work, "ood.md")
+        p = subprocess.run([sys.executable, os.path.join(tools, "sun_cnn_ood.py"), "--manifest",
+                            manifest, "--model", model, "--out", table],
+                           capture_output=True, text=True)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        with open(table) as f:
+            text = f.read()
+        for split in ("train", "val", "test"):
+            self.assertIn(f"\n| {split} | ", text)
+        self.assertEqual(text.count("\n| real_"), 1)  # the test split's real folder
+        self.assertEqual(text.count("\n| val, "), 2)
+        self.assertEqual(text.count("\n| trunk | weak |"), 5)  # FEATURE_GAINS
+        self.assertEqual(text.count("\n| fc1 | far |"), 5)
+
     def test_members_trained_apart_join_into_the_same_ensemble(self):
         """Two members trained in two processes (--first-member, --save-members) and joined with
         --load-members export the same model, byte for byte, as one process training both."""

@@ -62,6 +62,13 @@ Status SunCnnOptions::validate() const {
     return range("elevation_gain", "[0, 100]");
   if (!(gray_elevation_gain >= 0.0 && gray_elevation_gain <= 100.0))
     return range("gray_elevation_gain", "[0, 100]");
+  if (!(feature_gain >= 0.0 && feature_gain <= 100.0)) return range("feature_gain", "[0, 100]");
+  if (!(gray_feature_gain >= 0.0 && gray_feature_gain <= 100.0))
+    return range("gray_feature_gain", "[0, 100]");
+  SUNVO_RETURN_IF_ERROR(
+      feature_prior.validate(ensemble_members, mask1_size, "suncnn.feature_prior"));
+  SUNVO_RETURN_IF_ERROR(
+      gray_feature_prior.validate(ensemble_members, mask1_size, "suncnn.gray_feature_prior"));
   if (!(max_up_tilt_deg >= 0.0 && max_up_tilt_deg <= 90.0))
     return range("max_up_tilt_deg", "[0, 90]");
   return Status::ok();
@@ -109,12 +116,38 @@ Status SunCnnEstimator::finishInit() {
   mask2_.create(o.mask_rows, o.mask2_size, CV_32F);
   mask1_.setTo(cv::Scalar(1.0));
   mask2_.setTo(cv::Scalar(1.0));
+  // With a feature prior, each member's trunk output is read too: the graph's Flatten nodes
+  // (one per member, in member order: "onnx_node!/Flatten", "..._1", ...).
+  out_names_.assign(1, "azimuth_cs");
+  if (!o.feature_prior.empty() || !o.gray_feature_prior.empty()) {
+    std::vector<cv::String> trunks;
+    for (const cv::String& n : net_.getLayerNames()) {
+      const std::string s = n;
+      if (s.rfind("onnx_node!/Flatten", 0) == 0 && s.find("/flatten") == std::string::npos)
+        trunks.push_back(n);
+    }
+    std::sort(trunks.begin(), trunks.end(), [](const cv::String& a, const cv::String& b) {
+      return a.size() != b.size() ? a.size() < b.size() : a < b;
+    });
+    if (static_cast<int>(trunks.size()) != o.ensemble_members)
+      return invalidArgument("suncnn: the model has " + std::to_string(trunks.size()) +
+                             " trunk outputs (Flatten nodes), suncnn.feature_prior needs one per "
+                             "member (" +
+                             std::to_string(o.ensemble_members) + ")");
+    out_names_.insert(out_names_.end(), trunks.begin(), trunks.end());
+  }
   // One forward pass checks the model against the shapes the options promise.
   try {
     net_.setInput(blob_, "image");
     net_.setInput(mask1_, "mask1");
     net_.setInput(mask2_, "mask2");
-    out_ = net_.forward("azimuth_cs");
+    net_.forward(outs_, out_names_);
+    out_ = outs_[0];
+    for (std::size_t i = 1; i < outs_.size(); ++i)
+      if (outs_[i].total() != static_cast<std::size_t>(o.mask1_size))
+        return invalidArgument("suncnn: trunk output " + std::string(out_names_[i]) + " has " +
+                               std::to_string(outs_[i].total()) + " values, suncnn.mask1_size is " +
+                               std::to_string(o.mask1_size));
   } catch (const cv::Exception& e) {
     return invalidArgument(
         "suncnn: the model does not run with the shapes of suncnn.input_width/input_height/"
@@ -206,12 +239,12 @@ Expected<sunfusion::ImageSunEstimate> SunCnnEstimator::estimate(
     net_.setInput(blob_, "image");
     net_.setInput(mask1_, "mask1");
     net_.setInput(mask2_, "mask2");
-    net_.forward(outs_, "azimuth_cs");
+    net_.forward(outs_, out_names_);
   } catch (const cv::Exception& e) {
     return invalidArgument(std::string("suncnn: forward failed: ") + e.msg);
   }
   const int M = o.ensemble_members, K = o.mask_rows;
-  if (outs_.empty() || outs_[0].total() != static_cast<std::size_t>(M * K) * 2)
+  if (outs_.size() != out_names_.size() || outs_[0].total() != static_cast<std::size_t>(M * K) * 2)
     return invalidArgument("suncnn: unexpected model output size");
   const float* out = outs_[0].ptr<float>();
 
@@ -241,9 +274,17 @@ Expected<sunfusion::ImageSunEstimate> SunCnnEstimator::estimate(
       raw.gray_calibration ? o.gray_max_valid_sigma_rad : o.max_valid_sigma_rad;
   const double gain = raw.gray_calibration ? o.gray_elevation_gain : o.elevation_gain;
   raw.elevation_tan2 = input.prior ? elevationTan2(*input.prior) : 0.0;
+  const SunCnnFeaturePrior& fp = raw.gray_calibration ? o.gray_feature_prior : o.feature_prior;
+  const double f_gain = raw.gray_calibration ? o.gray_feature_gain : o.feature_gain;
+  if (!fp.empty() && outs_.size() == static_cast<std::size_t>(M) + 1) {
+    double d = 0.0;
+    for (int m = 0; m < M; ++m) d += fp.memberDistance(m, outs_[1 + m].ptr<float>()) / M;
+    raw.feature_distance = d;
+    raw.feature_weakness = featureWeakness(d);
+  }
   raw.sigma_rad =
       std::clamp(scale * std::sqrt(circularStdSquared(raw.r_mc) + circularStdSquared(raw.r_al) +
-                                   gain * raw.elevation_tan2),
+                                   gain * raw.elevation_tan2 + f_gain * raw.feature_weakness),
                  o.sigma_min_rad, o.sigma_max_rad);
   raw_ = raw;
 

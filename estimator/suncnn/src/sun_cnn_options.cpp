@@ -6,6 +6,8 @@
 #include <limits>
 #include <sstream>
 #include <type_traits>
+#include <utility>
+#include <vector>
 
 #include "sunvo/suncnn/sun_cnn_estimator.hpp"
 
@@ -68,6 +70,62 @@ Expected<SunCnnOptions> loadSunCnnOptions(const std::string& json_path, const Su
       }
       out = static_cast<T>(v);
     };
+    // A list of numbers; a missing key leaves `out` empty.
+    const auto numbers = [&](const YAML::Node& parent, const char* key, const std::string& name,
+                             std::vector<double>& out) {
+      out.clear();
+      if (!st.isOk()) return;
+      const YAML::Node n = parent[key];
+      if (!n || n.IsNull()) return;
+      if (!n.IsSequence()) {
+        st = parseError("suncnn: " + json_path + ": key '" + name + "' is not a list");
+        return;
+      }
+      out.reserve(n.size());
+      for (std::size_t i = 0; i < n.size(); ++i) {
+        double v = 0.0;
+        if (!n[i].IsScalar() || !YAML::convert<double>::decode(n[i], v) || !std::isfinite(v)) {
+          st = parseError("suncnn: " + json_path + ": key '" + name + "[" + std::to_string(i) +
+                          "]' is not a number");
+          return;
+        }
+        out.push_back(v);
+      }
+    };
+    // A feature prior (sun_cnn_features.hpp): components, features, and per member its mean,
+    // axes and variances, concatenated member after member. Sizes are checked by validate().
+    const auto prior = [&](const YAML::Node& parent, const std::string& name,
+                           SunCnnFeaturePrior& out) {
+      out = SunCnnFeaturePrior{};
+      const YAML::Node n = parent["feature_prior"];
+      if (!n || n.IsNull() || !st.isOk()) return;
+      if (!n.IsMap()) {
+        st = parseError("suncnn: " + json_path + ": key '" + name + "' is not an object");
+        return;
+      }
+      num(n, "components", name + ".components", out.components);
+      num(n, "features", name + ".features", out.features);
+      const YAML::Node members = n["members"];
+      if (st.isOk() && (!members || !members.IsSequence())) {
+        st = parseError("suncnn: " + json_path + ": key '" + name + ".members' is not a list");
+        return;
+      }
+      std::vector<double> part;
+      for (std::size_t m = 0; st.isOk() && m < members.size(); ++m) {
+        const std::string at = name + ".members[" + std::to_string(m) + "]";
+        if (!members[m].IsMap()) {
+          st = parseError("suncnn: " + json_path + ": key '" + at + "' is not an object");
+          return;
+        }
+        for (auto [key, dst] : {std::pair{"mean", &out.mean}, std::pair{"axes", &out.axes},
+                                std::pair{"variances", &out.variances}}) {
+          numbers(members[m], key, at + "." + key, part);
+          dst->insert(dst->end(), part.begin(), part.end());
+        }
+      }
+      if (st.isOk() && out.components == 0)
+        st = parseError("suncnn: " + json_path + ": key '" + name + ".components' is 0");
+    };
     const YAML::Node in_node = section("input"), mc = section("mc");
     num(in_node, "width", "input.width", o.input_width);
     num(in_node, "height", "input.height", o.input_height);
@@ -82,6 +140,10 @@ Expected<SunCnnOptions> loadSunCnnOptions(const std::string& json_path, const Su
     // A JSON without the elevation gain was calibrated without the elevation term: gain 0.
     o.elevation_gain = 0.0;
     num(root, "elevation_gain", "elevation_gain", o.elevation_gain);
+    // Likewise a JSON without the feature term: gain 0 and no prior.
+    o.feature_gain = 0.0;
+    num(root, "feature_gain", "feature_gain", o.feature_gain);
+    prior(root, "feature_prior", o.feature_prior);
     // Grey images on a colour model: their own calibration where the JSON has one, else the
     // colour calibration (a model calibrated before grey inputs had their own numbers).
     const YAML::Node gray = section("gray_input");
@@ -89,12 +151,17 @@ Expected<SunCnnOptions> loadSunCnnOptions(const std::string& json_path, const Su
       o.gray_sigma_scale = o.sigma_scale;
       o.gray_max_valid_sigma_rad = o.max_valid_sigma_rad;
       o.gray_elevation_gain = o.elevation_gain;
+      o.gray_feature_gain = o.feature_gain;
+      o.gray_feature_prior = o.feature_prior;
     } else {
       o.gray_elevation_gain = 0.0;
+      o.gray_feature_gain = 0.0;
+      prior(gray, "gray_input.feature_prior", o.gray_feature_prior);
     }
     num(gray, "sigma_scale", "gray_input.sigma_scale", o.gray_sigma_scale);
     num(gray, "max_valid_sigma_rad", "gray_input.max_valid_sigma_rad", o.gray_max_valid_sigma_rad);
     num(gray, "elevation_gain", "gray_input.elevation_gain", o.gray_elevation_gain);
+    num(gray, "feature_gain", "gray_input.feature_gain", o.gray_feature_gain);
   } catch (const YAML::Exception& e) {
     return parseError("suncnn: " + json_path + ": " + e.what());
   }

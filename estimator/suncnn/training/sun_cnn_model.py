@@ -177,3 +177,81 @@ def calibrate_elevation(err_deg, raw, tan2):
             best = (valid, gain, scale, threshold)
     return best[1], best[2], best[3]
 
+
+
+# The strength of the image's features as a third uncertainty signal (docs/sun_cnn_calibration.md,
+# "Distance from the training features"). Per member, the trunk's 768 features (dropout off) are
+# projected on the top FEATURE_PCS principal axes of the training images' features and whitened;
+#     d = mean over members of |z|^2 / FEATURE_PCS       (about 1 on the training images).
+# Measured as an out-of-distribution score it fails: the held-out looks lie nearer the training
+# mean than the training images, and their gross errors nearer still. Read the other way round it
+# is the strength of the sun cues the trunk found, which adds to the spread where that is small:
+#     raw' = sqrt(raw^2 + elevation_gain tan^2(e) + feature_gain max(0, -ln d)).
+# Only weak features widen sigma; strong or unusual ones never narrow it.
+FEATURE_PCS = 16
+FEATURE_GAINS = (0.0, 0.03, 0.1, 0.3, 1.0)
+
+
+def trunk_layers(net):
+    """The per-member trunk outputs (the Flatten nodes) of an exported graph, member order."""
+    names = [n for n in net.getLayerNames()
+             if n.startswith("onnx_node!/Flatten") and not n.endswith("/flatten")]
+    return sorted(names, key=lambda n: (len(n), n))  # Flatten, Flatten_1, Flatten_2, ...
+
+
+def fit_feature_prior(trunk):
+    """The training features' Gaussian per member, from trunk [M, n, F]: mean [M, F], the top
+    FEATURE_PCS principal axes [M, P, F] and their variances [M, P]."""
+    mean = trunk.mean(1)
+    axes, var = [], []
+    for m in range(trunk.shape[0]):
+        w, v = np.linalg.eigh(np.cov((trunk[m] - mean[m]).T))
+        top = np.argsort(w)[::-1][:FEATURE_PCS]
+        axes.append(v[:, top].T)
+        var.append(np.maximum(w[top], 1e-12))
+    return {"mean": mean, "axes": np.stack(axes), "variances": np.stack(var)}
+
+
+def feature_distance(prior, trunk):
+    """d per image (see above) from trunk [M, n, F]."""
+    d = np.zeros(trunk.shape[1])
+    for m in range(trunk.shape[0]):
+        z = (trunk[m] - prior["mean"][m]) @ prior["axes"][m].T
+        d += (z ** 2 / prior["variances"][m]).sum(1) / z.shape[1]
+    return d / trunk.shape[0]
+
+
+def feature_weakness(d):
+    return np.maximum(0.0, -np.log(np.maximum(d, 1e-12)))
+
+
+def calibrate_features(err_deg, raw, tan2, weakness):
+    """The feature gain in FEATURE_GAINS, raw the spread with the elevation term already in it:
+    the one whose calibrate() leaves the most validation frames valid (the smallest on a tie).
+    Returns (gain, scale, threshold)."""
+    best = None
+    for gain in FEATURE_GAINS:
+        r = np.sqrt(raw ** 2 + gain * weakness)
+        scale, threshold = calibrate(err_deg, r, tan2)
+        valid = float(np.mean(sigma_of(r, scale) <= threshold))
+        if best is None or valid > best[0] + 1e-12:
+            best = (valid, gain, scale, threshold)
+    return best[1], best[2], best[3]
+
+
+def feature_prior_json(prior):
+    """The prior as the model JSON holds it (5 significant digits)."""
+    def r(a):
+        return [float(f"{x:.5g}") for x in np.asarray(a, np.float64).ravel()]
+    return {"components": int(prior["axes"].shape[1]), "features": int(prior["axes"].shape[2]),
+            "members": [{"mean": r(prior["mean"][m]), "axes": r(prior["axes"][m]),
+                         "variances": r(prior["variances"][m])}
+                        for m in range(prior["axes"].shape[0])]}
+
+
+def feature_prior_from_json(j):
+    p, f = j["components"], j["features"]
+    ms = j["members"]
+    return {"mean": np.array([m["mean"] for m in ms]),
+            "axes": np.array([m["axes"] for m in ms]).reshape(len(ms), p, f),
+            "variances": np.array([m["variances"] for m in ms])}

@@ -29,8 +29,10 @@
 // its azimuth, which the spread alone misses (docs/sun_cnn_calibration.md):
 //   sigma = clamp(sigma_scale * sqrt(-2 ln R_mc - 2 ln R_al + elevation_gain tan^2 e'),
 //                 sigma_min_rad, sigma_max_rad),   e' = min(e, 85 deg), tan e' = 0 for e <= 0
-// (no prior: no elevation term). elevation_gain, sigma_scale and max_valid_sigma_rad are chosen
-// on the validation renders (held-out styles).
+// (no prior: no elevation term), and a fourth from how weak the trunk's features are against the
+// training images' (sun_cnn_features.hpp): + feature_gain max(0, -ln d) under the root, where the
+// model's JSON has a feature prior (none: no term). elevation_gain, feature_gain, sigma_scale and
+// max_valid_sigma_rad are chosen on the validation renders (held-out styles).
 //
 // The library opens no file but the model, and only when init() is given a path.
 
@@ -42,6 +44,7 @@
 #include <vector>
 
 #include "sunvo/core/status.hpp"
+#include "sunvo/suncnn/sun_cnn_features.hpp"
 #include "sunvo/sunfusion/image_sun_estimator.hpp"
 
 namespace sunvo::suncnn {
@@ -58,11 +61,11 @@ struct SunCnnOptions {
   int mask2_size = 128;         // D, hidden units into the second FC layer, must match, [1, 1e6]
   double dropout_p = 0.3;       // dropout probability used in training, [0, 0.9]
   int mc_samples = 16;          // N, MC dropout samples per image, [0, mask_rows - 1]; 0: R_mc = 1
-  double sigma_scale = 0.6735;  // calibration factor on the spread sigma, (0, 100]; fitted
+  double sigma_scale = 0.4896;  // calibration factor on the spread sigma, (0, 100]; fitted
                                 // on the validation renders (config/sun_cnn.json)
   double sigma_min_rad = 0.03;  // floor of the reported sigma, rad, [0, 1]
   double sigma_max_rad = 3.0;   // cap of the reported sigma, rad, [sigma_min_rad, 10]
-  double max_valid_sigma_rad = 0.4954;  // above this the estimate is returned with
+  double max_valid_sigma_rad = 0.4802;  // above this the estimate is returned with
                                         // valid = false, rad, (0, 10]; chosen on the validation
                                         // renders (config/sun_cnn.json)
   // The same two numbers for a grey image fed to a colour model as (Y, Y, Y) (grey V4L2 or
@@ -77,6 +80,14 @@ struct SunCnnOptions {
   // without the key was calibrated without the term, so it means 0.
   double elevation_gain = 0.01;
   double gray_elevation_gain = 0.0;
+  // Weight of the features' weakness max(0, -ln d) in the squared raw spread, rad^2, [0, 100];
+  // 0: off. It applies only with a prior (the JSON's "feature_prior", gray_input's for grey
+  // images; the defaults have none, so without the JSON the term is 0). A JSON without
+  // "feature_gain" means 0.
+  double feature_gain = 0.3;
+  double gray_feature_gain = 0.0;
+  SunCnnFeaturePrior feature_prior;       // fitted on the training renders; empty: no term
+  SunCnnFeaturePrior gray_feature_prior;  // the same for grey images on a colour model
   double max_up_tilt_deg = 30.0;  // valid = false when the prior's "up" is further than this
                                   // from the camera's -y (the azimuth is in the x-z plane), deg,
                                   // [0, 90]; ignored without a prior
@@ -86,7 +97,7 @@ struct SunCnnOptions {
 
 // The JSON the training script writes beside a model (<model>.json): the input size and
 // channels, ensemble members, mask sizes, dropout, sigma_scale, max_valid_sigma_rad and
-// elevation_gain (and for a colour model gray_input's three), over
+// elevation_gain, feature_gain and feature_prior (and for a colour model gray_input's), over
 // `base` (keys it lacks keep base's values). Errors name the file and the key.
 Expected<SunCnnOptions> loadSunCnnOptions(const std::string& json_path,
                                           const SunCnnOptions& base = {});
@@ -98,13 +109,15 @@ Expected<SunCnnOptions> optionsForModel(const std::string& model_path);
 
 // The raw network answer for one image, before the uncertainty is turned into a measurement.
 struct SunCnnRaw {
-  double c = 0.0, s = 0.0;        // deterministic output (dropout off)
-  double r_mc = 1.0;              // mean resultant length of the MC sample directions, [0, 1]
-  double r_al = 0.0;              // length of the deterministic output, clamped to [0, 1]
-  double elevation_tan2 = 0.0;    // tan^2 of the prior's sun elevation (capped at 85 deg), 0
-                                  // below the horizon or without a prior
-  double sigma_rad = 0.0;         // after scale and clamp
-  bool gray_calibration = false;  // a grey image on a colour model: the gray_* numbers applied
+  double c = 0.0, s = 0.0;         // deterministic output (dropout off)
+  double r_mc = 1.0;               // mean resultant length of the MC sample directions, [0, 1]
+  double r_al = 0.0;               // length of the deterministic output, clamped to [0, 1]
+  double feature_distance = -1.0;  // d (sun_cnn_features.hpp); -1 without a feature prior
+  double feature_weakness = 0.0;   // max(0, -ln d); 0 without a feature prior
+  double elevation_tan2 = 0.0;     // tan^2 of the prior's sun elevation (capped at 85 deg), 0
+                                   // below the horizon or without a prior
+  double sigma_rad = 0.0;          // after scale and clamp
+  bool gray_calibration = false;   // a grey image on a colour model: the gray_* numbers applied
 };
 
 class SunCnnEstimator : public sunfusion::ImageSunEstimator {
@@ -150,6 +163,7 @@ class SunCnnEstimator : public sunfusion::ImageSunEstimator {
   cv::Mat blob_;    // [1, C, H, W] CV_32F
   cv::Mat mask1_, mask2_, out_;
   std::vector<cv::Mat> outs_;
+  std::vector<cv::String> out_names_;  // "azimuth_cs", then each member's trunk if a prior needs it
   SunCnnRaw raw_;
 };
 
