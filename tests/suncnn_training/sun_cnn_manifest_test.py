@@ -284,30 +284,35 @@ class EndToEnd(Base):
         set_name = os.path.basename(os.path.normpath(ARGS.frames))
         self.assertIn(f"| sun_cnn | {set_name} | 11 |", p.stdout)
 
+    def study(self, tool, splits):
+        """Runs a study tool of the training folder on the shipped colour model, with the real
+        frames split by their rows of the sun file (split -> frame indices); returns its tables."""
+        with open(ARGS.sun_csv) as f:
+            header, *rows = f.read().splitlines()
+        args = []
+        name = os.path.splitext(tool)[0]
+        for split, frames in splits.items():
+            path = os.path.join(self.work, f"{name}_{split}.csv")
+            with open(path, "w") as f:
+                f.write("\n".join([header] + [rows[i] for i in frames]) + "\n")
+            args += ["--real", f"{ARGS.frames}:{path}:{split}"]
+        manifest, _ = self.manifest(*args)
+        tools = os.path.dirname(os.path.abspath(ARGS.trainer))
+        model = os.path.join(tools, "..", "..", "..", "config", "sun_cnn.onnx")
+        table = os.path.join(self.work, f"{name}.md")
+        p = subprocess.run([sys.executable, os.path.join(tools, tool), "--manifest", manifest,
+                            "--model", model, "--out", table], capture_output=True, text=True)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        with open(table) as f:
+            return f.read()
+
     def test_uncertainty_signals_run_on_the_shipped_model(self):
         """sun_cnn_signals.py (the flip/gamma views and the sun's elevation, docs/
         sun_cnn_calibration.md) on the real frames as validation (0-5) and test (6-10) rows: one
         row per view and gain, the ranking table and three calibrations per split."""
         if not ARGS.trainer:
             self.skipTest("needs --trainer")
-        with open(ARGS.sun_csv) as f:
-            lines = f.read().splitlines()
-        args = []
-        for split, part in {"val": lines[0:7], "test": [lines[0]] + lines[7:12]}.items():
-            path = os.path.join(self.work, f"signals_{split}.csv")
-            with open(path, "w") as f:
-                f.write("\n".join(part) + "\n")
-            args += ["--real", f"{ARGS.frames}:{path}:{split}"]
-        manifest, _ = self.manifest(*args)
-        tools = os.path.dirname(os.path.abspath(ARGS.trainer))
-        model = os.path.join(tools, "..", "..", "..", "config", "sun_cnn.onnx")
-        table = os.path.join(self.work, "signals.md")
-        p = subprocess.run([sys.executable, os.path.join(tools, "sun_cnn_signals.py"), "--manifest",
-                            manifest, "--model", model, "--out", table],
-                           capture_output=True, text=True)
-        self.assertEqual(p.returncode, 0, p.stderr)
-        with open(table) as f:
-            text = f.read()
+        text = self.study("sun_cnn_signals.py", {"val": range(0, 6), "test": range(6, 11)})
         self.assertEqual(text.count("\n| flip |"), 5)
         self.assertEqual(text.count("\n| plain | 0 |"), 1)
         self.assertEqual(text.count("\n| val | "), 1 + 3)  # the ranking row, three calibrations
@@ -320,25 +325,8 @@ class EndToEnd(Base):
         row per signal, form and gain."""
         if not ARGS.trainer:
             self.skipTest("needs --trainer")
-        with open(ARGS.sun_csv) as f:
-            lines = f.read().splitlines()
-        args = []
-        for split, part in {"train": lines[0:5], "val": [lines[0]] + lines[5:9],
-                            "test": [lines[0]] + lines[9:12]}.items():
-            path = os.path.join(self.work, f"ood_{split}.csv")
-            with open(path, "w") as f:
-                f.write("\n".join(part) + "\n")
-            args += ["--real", f"{ARGS.frames}:{path}:{split}"]
-        manifest, _ = self.manifest(*args)
-        tools = os.path.dirname(os.path.abspath(ARGS.trainer))
-        model = os.path.join(tools, "..", "..", "..", "config", "sun_cnn.onnx")
-        table = os.path.join(self.work, "ood.md")
-        p = subprocess.run([sys.executable, os.path.join(tools, "sun_cnn_ood.py"), "--manifest",
-                            manifest, "--model", model, "--out", table],
-                           capture_output=True, text=True)
-        self.assertEqual(p.returncode, 0, p.stderr)
-        with open(table) as f:
-            text = f.read()
+        text = self.study("sun_cnn_ood.py", {"train": range(0, 4), "val": range(4, 8),
+                                             "test": range(8, 11)})
         for split in ("train", "val", "test"):
             self.assertIn(f"\n| {split} | ", text)
         self.assertEqual(text.count("\n| real_"), 1)  # the test split's real folder

@@ -26,7 +26,7 @@ from sun_cnn_model import (DROPOUT_P, FEATURE_PCS, IN_H, IN_W, MEAN, STD, calibr
                            calibrate_features, combine, elevation_tan2, feature_distance,
                            feature_prior_json, feature_weakness, fit_feature_prior, trunk_layers,
                            with_elevation)
-from sun_cnn_train import LUMA, load, report, signed_deg, targets
+from sun_cnn_train import LUMA, labelled, load, report, signed_deg
 
 SAMPLES = 16
 MIN_TRAIN_FOR_PRIOR = 4 * FEATURE_PCS  # training images, else no feature term
@@ -100,14 +100,11 @@ def main():
     def calibrated(grey_in, splits, rng):
         evals = {}
         for split in splits:
-            x, sun, scen = data[split]
-            t, w = targets(sun)
-            keep = w > 0
-            dets, samps, trunk = run_model(net, meta, x[keep], rng, grey_in, layers)
+            x, t, scen, sun = labelled(data, split, a.manifest)
+            dets, samps, trunk = run_model(net, meta, x, rng, grey_in, layers)
             trunk = np.stack(trunk)  # [M, n, F]
             v, raw = combine(dets, samps)
-            evals[split] = (signed_deg(v, t[keep]), raw, np.array(scen)[keep],
-                            elevation_tan2(sun[keep]), trunk)
+            evals[split] = (signed_deg(v, t), raw, scen, elevation_tan2(sun), trunk)
         val_err, val_raw, _, val_tan2, _ = evals["val"]
         gain, scale, threshold = calibrate_elevation(val_err, val_raw, val_tan2)
         weak = {k: np.zeros(len(e[0])) for k, e in evals.items()}

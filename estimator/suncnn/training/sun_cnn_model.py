@@ -168,15 +168,19 @@ def calibrate_elevation(err_deg, raw, tan2):
     ELEVATION_GAINS whose threshold (still flagging 90 % of the validation gross errors in every
     band) leaves the most validation frames valid; the smallest such gain on a tie. Returns
     (gain, scale, threshold)."""
+    return most_valid(err_deg, tan2, ((g, with_elevation(raw, tan2, g)) for g in ELEVATION_GAINS))
+
+
+def most_valid(err_deg, tan2, candidates):
+    """Of (gain, raw') candidates, in order, the one whose calibrate() leaves the most frames
+    valid; the first on a tie. Returns (gain, scale, threshold)."""
     best = None
-    for gain in ELEVATION_GAINS:
-        r = with_elevation(raw, tan2, gain)
+    for gain, r in candidates:
         scale, threshold = calibrate(err_deg, r, tan2)
         valid = float(np.mean(sigma_of(r, scale) <= threshold))
         if best is None or valid > best[0] + 1e-12:
             best = (valid, gain, scale, threshold)
     return best[1], best[2], best[3]
-
 
 
 # The strength of the image's features as a third uncertainty signal (docs/sun_cnn_calibration.md,
@@ -192,11 +196,16 @@ FEATURE_PCS = 16
 FEATURE_GAINS = (0.0, 0.03, 0.1, 0.3, 1.0)
 
 
+def member_layers(net, keep):
+    """Names of an exported graph's layers that keep() accepts, one per member, in member order
+    (name, name_1, name_2, ...)."""
+    return sorted((n for n in net.getLayerNames() if keep(n)), key=lambda n: (len(n), n))
+
+
 def trunk_layers(net):
     """The per-member trunk outputs (the Flatten nodes) of an exported graph, member order."""
-    names = [n for n in net.getLayerNames()
-             if n.startswith("onnx_node!/Flatten") and not n.endswith("/flatten")]
-    return sorted(names, key=lambda n: (len(n), n))  # Flatten, Flatten_1, Flatten_2, ...
+    return member_layers(net, lambda n: n.startswith("onnx_node!/Flatten")
+                         and not n.endswith("/flatten"))
 
 
 def fit_feature_prior(trunk):
@@ -229,14 +238,8 @@ def calibrate_features(err_deg, raw, tan2, weakness):
     """The feature gain in FEATURE_GAINS, raw the spread with the elevation term already in it:
     the one whose calibrate() leaves the most validation frames valid (the smallest on a tie).
     Returns (gain, scale, threshold)."""
-    best = None
-    for gain in FEATURE_GAINS:
-        r = np.sqrt(raw ** 2 + gain * weakness)
-        scale, threshold = calibrate(err_deg, r, tan2)
-        valid = float(np.mean(sigma_of(r, scale) <= threshold))
-        if best is None or valid > best[0] + 1e-12:
-            best = (valid, gain, scale, threshold)
-    return best[1], best[2], best[3]
+    return most_valid(err_deg, tan2,
+                      ((g, np.sqrt(raw ** 2 + g * weakness)) for g in FEATURE_GAINS))
 
 
 def feature_prior_json(prior):

@@ -33,16 +33,16 @@ import numpy as np
 
 from sun_cnn_calibrate import run_model
 from sun_cnn_model import (FEATURE_GAINS, calibrate, combine, elevation_tan2, feature_distance,
-                           feature_weakness, fit_feature_prior, sigma_of, trunk_layers)
+                           feature_weakness, fit_feature_prior, member_layers, sigma_of,
+                           trunk_layers)
 from sun_cnn_signals import auc, pct
-from sun_cnn_train import grey_as_colour, load, signed_deg, targets
+from sun_cnn_train import labelled, load, signed_deg
 
 SHRINK = 0.1
 
 
 def fc1_layers(net):
-    names = [n for n in net.getLayerNames() if n.startswith("onnx_node!/fc1") and n.endswith("Gemm")]
-    return sorted(names, key=lambda n: (len(n), n))  # fc1, fc1_1, fc1_2, ...
+    return member_layers(net, lambda n: n.startswith("onnx_node!/fc1") and n.endswith("Gemm"))
 
 
 def shrunk_distance(train, feats):
@@ -80,14 +80,7 @@ def main():
     rng = np.random.default_rng(a.seed)
     per = {}
     for split in ("train", "val", "test"):
-        if split not in data:
-            raise SystemExit(f"{a.manifest}: no {split} rows")
-        x, sun, scen = data[split]
-        t, w = targets(sun)
-        keep = w > 0
-        x, t, scen, sun = x[keep], t[keep], np.array(scen)[keep], sun[keep]
-        if a.grey:
-            x = grey_as_colour(x)
+        x, t, scen, sun = labelled(data, split, a.manifest, a.grey)
         dets, samps, extra = run_model(net, meta, x, rng, layers=layers)
         v, raw = combine(dets, samps)
         per[split] = dict(err=np.abs(signed_deg(v, t)), raw=raw, scen=scen, fc1=np.stack(extra[:members]),

@@ -30,7 +30,7 @@ import numpy as np
 from sun_cnn_calibrate import run_model
 from sun_cnn_model import (ELEVATION_BANDS_DEG, calibrate, calibrate_elevation, combine,
                            elevation_band, elevation_tan2, sigma_of, with_elevation)
-from sun_cnn_train import grey_as_colour, load, report, signed_deg, targets
+from sun_cnn_train import labelled, load, report, signed_deg
 
 KS = (0.0, 0.25, 0.5, 1.0, 2.0, 4.0)
 NAN = float("nan")
@@ -162,14 +162,7 @@ def main():
     rng = np.random.default_rng(a.seed)
     per = {}
     for split in ("val", "test"):
-        if split not in data:
-            raise SystemExit(f"{a.manifest}: no {split} rows")
-        x, sun, scen = data[split]
-        t, w = targets(sun)
-        keep = w > 0
-        x, t, scen, sun = x[keep], t[keep], np.array(scen)[keep], sun[keep]
-        if a.grey:
-            x = grey_as_colour(x)
+        x, t, scen, sun = labelled(data, split, a.manifest, a.grey)
         v, raw = combine(*run_model(net, meta, x, rng))
         flip = mirrored(run_model(net, meta, x[:, :, ::-1].copy(), rng)[0].mean(0))
         g_lo = run_model(net, meta, gamma(x, 0.6), rng)[0].mean(0)

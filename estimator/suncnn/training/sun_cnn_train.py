@@ -69,6 +69,19 @@ def targets(sun):
     return t.astype(np.float32), (xz > 0.2).astype(np.float32)
 
 
+def labelled(data, split, manifest, grey=False):
+    """One split of load()'s data, the rows whose azimuth is defined (targets' weight > 0):
+    images (grey=True: as a grey camera gives them to a colour model), targets, scenarios and
+    sun vectors. A manifest without the split is an error naming it."""
+    if split not in data:
+        raise SystemExit(f"{manifest}: no {split} rows")
+    x, sun, scen = data[split]
+    t, w = targets(sun)
+    keep = w > 0
+    x = grey_as_colour(x[keep]) if grey else x[keep]
+    return x, t[keep], np.array(scen)[keep], sun[keep]
+
+
 def to_input(bgr_float, channels):
     """N,H,W,3 float in [0, 255] -> N,C,H,W normalised tensor (grey: BT.601 luma)."""
     x = bgr_float if channels == 3 else (bgr_float @ LUMA)[..., None]
