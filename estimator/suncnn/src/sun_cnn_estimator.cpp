@@ -276,7 +276,7 @@ Expected<sunfusion::ImageSunEstimate> SunCnnEstimator::estimate(
   raw.elevation_tan2 = input.prior ? elevationTan2(*input.prior) : 0.0;
   const SunCnnFeaturePrior& fp = raw.gray_calibration ? o.gray_feature_prior : o.feature_prior;
   const double f_gain = raw.gray_calibration ? o.gray_feature_gain : o.feature_gain;
-  if (!fp.empty() && outs_.size() == static_cast<std::size_t>(M) + 1) {
+  if (!fp.empty()) {  // then out_names_ holds the M trunks, and outs_ matched it above
     double d = 0.0;
     for (int m = 0; m < M; ++m) d += fp.memberDistance(m, outs_[1 + m].ptr<float>()) / M;
     raw.feature_distance = d;
