@@ -334,6 +334,18 @@ class EndToEnd(Base):
         self.assertEqual(text.count("\n| trunk | weak |"), 5)  # FEATURE_GAINS
         self.assertEqual(text.count("\n| fc1 | far |"), 5)
 
+    def test_confidence_head_study_runs_on_the_shipped_model(self):
+        """sun_cnn_head.py (a learned confidence head, docs/sun_cnn_calibration.md) on the real
+        frames as validation (0-6; one drive, so its folds are frames) and test (7-10) rows: the
+        shipped sigma's row and one row per form, signal set and lambda, and the weights."""
+        if not ARGS.trainer:
+            self.skipTest("needs --trainer")
+        text = self.study("sun_cnn_head.py", {"val": range(0, 7), "test": range(7, 11)})
+        self.assertEqual(text.count("\n| shipped sigma |"), 1)
+        self.assertEqual(text.count("\n| log-error, scalars |"), 4)  # LAMBDAS
+        self.assertEqual(text.count("\n| gross, scalars + z |"), 4)
+        self.assertIn("\n| ln tan2 | ", text)
+
     def test_members_trained_apart_join_into_the_same_ensemble(self):
         """Two members trained in two processes (--first-member, --save-members) and joined with
         --load-members export the same model, byte for byte, as one process training both."""

@@ -113,6 +113,21 @@ def elevation_band(tan2):
     return np.digitize(np.degrees(np.arctan(np.sqrt(tan2))), ELEVATION_BANDS_DEG[1:-1])
 
 
+def flag_threshold(err_deg, raw, tan2=None):
+    """calibrate()'s threshold on raw: the 10th percentile of raw over the gross (> 45 deg)
+    errors (inf with fewer than 5), or with tan2 the lowest such percentile over the elevation
+    bands holding at least 10 gross errors."""
+    gross = np.abs(err_deg) > 45
+    tau = np.percentile(raw[gross], 10) if gross.sum() >= 5 else np.inf
+    if tan2 is not None:
+        band = elevation_band(tan2)
+        taus = [np.percentile(raw[gross & (band == b)], 10) for b in np.unique(band)
+                if (gross & (band == b)).sum() >= 10]
+        if taus:
+            tau = min(taus)
+    return tau
+
+
 def calibrate(err_deg, raw, tan2=None):
     """The validity threshold and the sigma scale, from validation errors (deg) and raw sigmas
     (rad). The threshold on raw sigma flags 90 % of the gross (> 45 deg) errors (the 10th
@@ -123,14 +138,7 @@ def calibrate(err_deg, raw, tan2=None):
     The scale then makes 95 % of the frames below it fall within 2 sigma, i.e. sigma is
     calibrated on the frames the estimator calls valid, which are the ones the fusion sees.
     Returns (scale, threshold on the scaled sigma in rad)."""
-    gross = np.abs(err_deg) > 45
-    tau = np.percentile(raw[gross], 10) if gross.sum() >= 5 else np.inf
-    if tan2 is not None:
-        band = elevation_band(tan2)
-        taus = [np.percentile(raw[gross & (band == b)], 10) for b in np.unique(band)
-                if (gross & (band == b)).sum() >= 10]
-        if taus:
-            tau = min(taus)
+    tau = flag_threshold(err_deg, raw, tan2)
     valid = raw <= tau
     if valid.sum() < 5:
         valid = np.ones_like(valid)
