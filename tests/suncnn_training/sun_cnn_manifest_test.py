@@ -346,6 +346,18 @@ class EndToEnd(Base):
         self.assertEqual(text.count("\n| gross, scalars + z |"), 4)
         self.assertIn("\n| ln tan2 | ", text)
 
+    def test_model_pair_study_runs_on_the_shipped_models(self):
+        """sun_cnn_pair.py (the colour and the grey model as one ensemble, docs/
+        sun_cnn_calibration.md) on the real frames as validation (0-6) and test (7-10) rows: the
+        shipped row, one row per model and the pair, and the pair with the feature term."""
+        if not ARGS.trainer:
+            self.skipTest("needs --trainer")
+        text = self.study("sun_cnn_pair.py", {"val": range(0, 7), "test": range(7, 11)})
+        self.assertEqual(text.count("\n| shipped (colour model, its JSON) |"), 1)
+        for run in ("colour", "grey", "both"):
+            self.assertEqual(text.count(f"\n| {run}, rule on val |"), 1)
+        self.assertEqual(text.count("\n| both + colour's feature term"), 1)
+
     def test_members_trained_apart_join_into_the_same_ensemble(self):
         """Two members trained in two processes (--first-member, --save-members) and joined with
         --load-members export the same model, byte for byte, as one process training both."""
