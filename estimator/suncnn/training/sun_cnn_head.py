@@ -36,7 +36,7 @@ import numpy as np
 from sun_cnn_calibrate import run_model
 from sun_cnn_model import (combine, elevation_tan2, feature_distance, feature_prior_from_json,
                            feature_weakness, flag_threshold, trunk_layers)
-from sun_cnn_signals import auc, pct
+from sun_cnn_signals import auc, emit, pct
 from sun_cnn_train import labelled, load, signed_deg
 
 FOLDS = 4
@@ -195,10 +195,7 @@ def main():
     lines += ["", "| signal | log-error head's weight (standardised, lambda 1) |", "| --- | ---: |"]
     lines += [f"| {n} | {w:+.3f} |" for n, w in zip(names, full.w[1:]) if not n.startswith("z")]
     table = "\n".join(lines)
-    print(table)
-    if a.out:
-        with open(a.out, "w") as f:
-            f.write(table + "\n")
+    emit(table, a.out)
 
 
 if __name__ == "__main__":

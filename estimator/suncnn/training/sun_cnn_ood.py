@@ -35,7 +35,7 @@ from sun_cnn_calibrate import run_model
 from sun_cnn_model import (FEATURE_GAINS, calibrate, combine, elevation_tan2, feature_distance,
                            feature_weakness, fit_feature_prior, member_layers, sigma_of,
                            trunk_layers)
-from sun_cnn_signals import auc, pct
+from sun_cnn_signals import auc, emit, pct
 from sun_cnn_train import labelled, load, signed_deg
 
 SHRINK = 0.1
@@ -139,10 +139,7 @@ def main():
                           if valid.any() else "–"]
                 lines.append(f"| {sig} | {form} | {k} | " + " | ".join(cells) + " |")
     table = "\n".join(lines)
-    print(table)
-    if a.out:
-        with open(a.out, "w") as f:
-            f.write(table + "\n")
+    emit(table, a.out)
 
 
 if __name__ == "__main__":

@@ -38,7 +38,7 @@ from sun_cnn_calibrate import run_model
 from sun_cnn_model import (calibrate_elevation, calibrate_features, combine, elevation_tan2,
                            feature_distance, feature_prior_from_json, feature_weakness, sigma_of,
                            trunk_layers, with_elevation)
-from sun_cnn_signals import auc, pct
+from sun_cnn_signals import auc, emit, pct
 from sun_cnn_train import labelled, load, metrics, signed_deg
 
 
@@ -151,10 +151,7 @@ def main():
                      f"| {pct(np.mean(gg[gc])) if gc.any() else '–'} | {corr:.2f} | "
                      f"{pct(np.mean(np.abs(eg) < np.abs(ec)))} |")
     table = "\n".join(lines)
-    print(table)
-    if a.out:
-        with open(a.out, "w") as f:
-            f.write(table + "\n")
+    emit(table, a.out)
 
 
 if __name__ == "__main__":

@@ -66,6 +66,14 @@ def auc(score, bad):
     return float((ranks[bad].sum() - nb * (nb + 1) / 2) / (nb * ng))
 
 
+def emit(table, out):
+    """Prints a study tool's tables and, given a path, writes them there too (markdown)."""
+    print(table)
+    if out:
+        with open(out, "w") as f:
+            f.write(table + "\n")
+
+
 def pct(x):
     return f"{100 * x:.0f} %" if np.isfinite(x) else "–"
 
@@ -174,10 +182,7 @@ def main():
         print(f"{split}: {len(t)} images", file=sys.stderr)
 
     table = "\n".join(view_rows(per) + [""] + ranking_rows(per) + [""] + band_rows(per))
-    print(table)
-    if a.out:
-        with open(a.out, "w") as f:
-            f.write(table + "\n")
+    emit(table, a.out)
 
 
 if __name__ == "__main__":
