@@ -2,9 +2,10 @@
 """Do the colour and the grey model answer better together? (docs/sun_cnn_calibration.md, "Both
 models as one ensemble").
 
-Two models ship, each a deep ensemble of three members trained from its own seeds on its own
-input (BGR, grey). Their errors are partly independent, so their six members together are a
-larger ensemble: the answer is the direction of the mean of the six deterministic vectors, and
+Two models ship, each a deep ensemble of three members trained on the same renders from the same
+seeds, each on its own input (BGR, grey). Where their errors are partly independent, their six
+members together are a larger ensemble: the answer is the direction of the mean of the six
+deterministic vectors, and
 the raw spread (sun_cnn_model.combine) counts the six members' MC samples and the mean's
 shortness, which grows where the two models disagree.
 
