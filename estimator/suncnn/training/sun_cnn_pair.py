@@ -5,9 +5,8 @@ models as one ensemble").
 Two models ship, each a deep ensemble of three members trained on the same renders from the same
 seeds, each on its own input (BGR, grey). Where their errors are partly independent, their six
 members together are a larger ensemble: the answer is the direction of the mean of the six
-deterministic vectors, and
-the raw spread (sun_cnn_model.combine) counts the six members' MC samples and the mean's
-shortness, which grows where the two models disagree.
+deterministic vectors, and the raw spread (sun_cnn_model.combine) counts the six members' MC
+samples and the mean's shortness, which grows where the two models disagree.
 
 For one camera (--camera colour: the colour model sees BGR; grey: it sees (Y, Y, Y), as the
 rover's grey V4L2 cameras give it; the grey model sees Y either way), rows:
