@@ -1,11 +1,23 @@
 #!/usr/bin/env python3
 """Splits a run's pose error by gravity: height and horizontal position error, tilt and heading
-attitude error, and the mean attitude error in the camera's own axes.
+attitude error, the mean attitude error in the camera's own axes, and the height the tilt error
+built.
 
 Usage: scripts/pose_error_split.py GT.txt RUN.txt [RUN.txt ...] [--up x,y,z]
+                                   [--cue-sigma-deg S --answers N]
 GT and RUN are KITTI pose files (12 numbers per line, T_w_c) of the same frames, e.g. those of
 `sunvo_experiment --write-poses` (route_<id>_gt.txt, route_<id>_run<i>.txt). --up is the world's
-up (default 0,-1,0: KITTI's first camera). Pure Python, no dependencies."""
+up (default 0,-1,0: KITTI's first camera). Pure Python, no dependencies.
+
+Height built by the tilt: a run whose world attitude is off by w (C_w,gt = Exp(w) C_w,run) moves
+each true step s by about -w x s, so its tilt part w_t (w less its part about up) builds the
+height error sum over steps of (-w_t x s) . up. What is left of the final height error is the
+steps' own (their length and direction in the camera).
+The cue's floor (with --cue-sigma-deg and --answers): a filter that corrects the tilt with N
+unbiased answers of per-axis std S leaves, whatever its gain, every answer's error in the sum of
+its tilt errors over the route (e_k = (1 - K) e_{k-1} + K n_k sums to about sum n_k), so the
+height it builds over a route of length L has a std of about S L / sqrt(N): a run whose own final
+height error is below that cannot be expected to gain height from such a cue."""
 import argparse
 import math
 
@@ -50,6 +62,10 @@ def dot(a, b):
     return sum(x * y for x, y in zip(a, b))
 
 
+def cross(a, b):
+    return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+
+
 def rms(values):
     return math.sqrt(sum(x * x for x in values) / len(values))
 
@@ -59,18 +75,29 @@ def main():
     parser.add_argument("gt")
     parser.add_argument("runs", nargs="+")
     parser.add_argument("--up", default="0,-1,0")
+    parser.add_argument("--cue-sigma-deg", type=float, default=0.0)
+    parser.add_argument("--answers", type=int, default=0)
     args = parser.parse_args()
+    if (args.cue_sigma_deg > 0.0) != (args.answers > 0):
+        raise SystemExit("--cue-sigma-deg and --answers go together (both > 0)")
     up = [float(x) for x in args.up.split(",")]
     norm = math.sqrt(dot(up, up))
     up = [x / norm for x in up]
     gt = load(args.gt)
+    steps = [[b[1][i] - a[1][i] for i in range(3)] for a, b in zip(gt, gt[1:])]
+    length = sum(math.sqrt(dot(st, st)) for st in steps)
+    if args.answers > 0:
+        floor = math.radians(args.cue_sigma_deg) * length / math.sqrt(args.answers)
+        print(f"{args.gt}: route {length:.1f} m; the cue's height floor "
+              f"{args.cue_sigma_deg:g} deg x {length:.1f} m / sqrt({args.answers}) = {floor:.2f} m")
     for path in args.runs:
         run = load(path)
         if len(run) != len(gt):
             raise SystemExit(f"{path}: {len(run)} poses, the ground truth has {len(gt)}")
         height, horiz, tilt, heading = [], [], [], []
         mean_c = [0.0, 0.0, 0.0]
-        for (r_gt, t_gt), (r, t) in zip(gt, run):
+        built = 0.0
+        for k, ((r_gt, t_gt), (r, t)) in enumerate(zip(gt, run)):
             e = [t[i] - t_gt[i] for i in range(3)]
             h = dot(e, up)
             height.append(h)
@@ -79,13 +106,17 @@ def main():
             hd = dot(w, up)
             heading.append(math.degrees(hd))
             tilt.append(math.degrees(math.sqrt(max(0.0, dot(w, w) - hd * hd))))
+            if k < len(steps):
+                w_t = [w[i] - hd * up[i] for i in range(3)]
+                built -= dot(cross(w_t, steps[k]), up)
             c_c_w = transpose(r_gt)
             for i in range(3):
                 mean_c[i] += math.degrees(dot(c_c_w[i], w)) / len(gt)
         print(f"{path}: height error RMS {rms(height):.2f} m, final {height[-1]:+.2f} m; "
               f"horizontal RMS {rms(horiz):.2f} m, final {horiz[-1]:.2f} m; tilt RMS "
               f"{rms(tilt):.2f} deg, heading RMS {rms(heading):.2f} deg; mean attitude error in "
-              f"the camera: pitch (x) {mean_c[0]:+.3f} deg, roll (z) {mean_c[2]:+.3f} deg")
+              f"the camera: pitch (x) {mean_c[0]:+.3f} deg, roll (z) {mean_c[2]:+.3f} deg; "
+              f"height built by the tilt {built:+.2f} m")
 
 
 if __name__ == "__main__":
