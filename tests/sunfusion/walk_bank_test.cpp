@@ -347,5 +347,37 @@ TEST(WalkBank, AHeadingBankToldTheTiltByTheCueReadsTheWalkCloser) {
   EXPECT_GT(alone, 2.0 * told) << alone;
 }
 
+// An error removed from outside (the fusion's levelled start): answers that saw an error growing
+// by 0.1 deg/frame, against 1 deg answers, make the fast walks the likely ones; restart() returns
+// the bank to a fresh one's walk and member weights, its members at zero with the given covariance
+// (the next answer's innovation at zero is the same for every member).
+TEST(WalkBank, ARestartForgetsTheErrorThatWasRemoved) {
+  WalkBank fresh;
+  WalkBank bank;
+  ASSERT_TRUE(fresh.init(bankOptions(1)).isOk());
+  ASSERT_TRUE(bank.init(bankOptions(1)).isOk());
+  const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+  Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
+  H(0, 0) = H(1, 1) = 1.0 / kDeg;
+  std::mt19937 rng(3);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  for (int k = 1; k <= 20; ++k) {  // 0.5 deg more per answer (every fifth frame), never corrected
+    bank.propagate(5.0, up);
+    bank.update(H, Eigen::Vector3d(0.5 * k + n01(rng), n01(rng), 0.0), 2);
+  }
+  ASSERT_GT(bank.tiltWalk(), 2.0 * fresh.tiltWalk());  // it has chosen faster walks
+  const Eigen::Matrix3d P_e = Eigen::Vector3d(0.25, 0.25, 4.0).asDiagonal() * (kDeg * kDeg);
+  bank.restart(P_e);
+  EXPECT_NEAR(bank.tiltWalk(), fresh.tiltWalk(), 1e-12 * fresh.tiltWalk());
+  EXPECT_NEAR(bank.walk(), fresh.walk(), 1e-12 * fresh.walk());
+  for (int m = 0; m < bank.members(); ++m) EXPECT_NEAR(bank.weight(m), fresh.weight(m), 1e-12);
+  // From then on it reads the answers as a fresh bank whose members start from P_e.
+  for (int k = 0; k < 20; ++k) {
+    bank.propagate(5.0, up);
+    bank.update(H, Eigen::Vector3d(n01(rng), n01(rng), 0.0), 2);
+  }
+  EXPECT_LT(bank.tiltWalk(), 1.5 * fresh.tiltWalk());
+}
+
 }  // namespace
 }  // namespace sunvo::sunfusion

@@ -66,6 +66,18 @@ Status WalkBank::init(const WalkBankOptions& o) {
   return Status::ok();
 }
 
+void WalkBank::restart(const Eigen::Matrix3d& P_e) {
+  for (int k = 0; k < members(); ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    const double sigma_c = bias_sigma_[biasOf(k)];
+    loglik_[i] = 0.0;
+    x_[i].setZero();
+    P_[i].setZero();
+    P_[i].topLeftCorner<3, 3>() = P_e;
+    P_[i].bottomRightCorner<2, 2>() = Eigen::Matrix2d::Identity() * sigma_c * sigma_c;
+  }
+}
+
 void WalkBank::propagate(double frames, const Eigen::Vector3d& up, double other_q) {
   const Eigen::Matrix3d uu = up * up.transpose();
   const Eigen::Matrix3d tilt_plane = Eigen::Matrix3d::Identity() - uu;

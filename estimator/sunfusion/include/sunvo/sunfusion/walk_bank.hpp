@@ -100,6 +100,11 @@ class WalkBank {
   void absorb(const Eigen::Matrix3d& H, const Eigen::Vector3d& r, int m, double s);
   // The estimate was corrected by the world rotation vector c_w.
   void shift(const Eigen::Vector3d& c_w);
+  // The error the members have been explaining was removed from outside (a levelled start): every
+  // member starts again from e = 0 with covariance P_e (the fusion's, after the removal), its bias
+  // at its prior and its likelihood at the prior's. Answers that saw the removed error would
+  // otherwise keep the fast walks that followed it chosen long after (docs/vertical_height.md).
+  void restart(const Eigen::Matrix3d& P_e);
   // The walk for a fusion that weighs the answers by their reported sigma, exp(E[log q - log s]),
   // rad per frame.
   double walk() const;
