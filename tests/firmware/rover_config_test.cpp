@@ -93,7 +93,7 @@ TEST(RoverConfig, DefaultsAndOverrides) {
   // The rover's defaults of the estimator: a 40 ms solver budget, the image estimators' cap.
   EXPECT_DOUBLE_EQ(c->estimator.pipeline.vo.window.max_solver_time_in_seconds, 0.040);
   EXPECT_DOUBLE_EQ(c->estimator.fusion.max_drift_deg_per_frame, 0.01);
-  EXPECT_DOUBLE_EQ(c->estimator.fusion.vertical_max_drift_deg_per_frame, 0.05);  // the cue's
+  EXPECT_DOUBLE_EQ(c->estimator.fusion.vertical_max_drift_deg_per_frame, 0.2);  // the cue's
   EXPECT_EQ(c->realtime.deadline_ms, 80.0);
   EXPECT_EQ(c->serial.device, "/dev/pts/9");
   EXPECT_EQ(c->sun.csv, "/data/sun.csv");

@@ -124,9 +124,13 @@ struct SunFusionOptions {
   // raises the tilt's walk. max_drift_deg_per_frame bounds the walks the sun's
   // measurements raise (an image estimator's is lowered for its street-long errors,
   // ImageEstimatorFusion); the cue's errors are not the sun's, so that bound is not the cue's
-  // either (measured: docs/vertical.md, "Two channels, two caps"). 0.05 = the default of
-  // max_drift_deg_per_frame, the cap of the cue alone.
-  double vertical_max_drift_deg_per_frame = 0.05;
+  // either (measured: docs/vertical.md, "Two channels, two caps"). 0.2 since 2026-12-03 (0.05,
+  // the sun's default, before): a walk trails a drift that is steady in the camera by a lag whose
+  // pitch part builds height on every heading, and on the real 0020 tracks (+0.0063 deg/frame
+  // about the camera's x) the cap held the walk there: with a perfect "up" 0.05 left 5.2 m of
+  // height, 0.2 1.6 m (the true tilt's final drift). The likelihood chooses below it elsewhere
+  // (docs/vertical_height.md: validation seeds, two rendered validation drives).
+  double vertical_max_drift_deg_per_frame = 0.2;
   // How the tilt's walk follows the vertical channel (above); evidence_sigmas,
   // evidence_forgetting and evidence_correlation are its test's with kEvidence.
   VerticalDriftAdaptation vertical_drift_adaptation = VerticalDriftAdaptation::kLikelihood;
