@@ -53,16 +53,7 @@ Status WalkBank::init(const WalkBankOptions& o) {
   for (int l = 1; l < biases_; ++l) {
     bias_sigma_[static_cast<std::size_t>(l)] = o.up_bias_max_rad * std::pow(0.5, biases_ - 1 - l);
   }
-  for (int k = 0; k < members(); ++k) {
-    const auto i = static_cast<std::size_t>(k);
-    const double sigma_c = bias_sigma_[biasOf(k)];
-    loglik_[i] = 0.0;
-    x_[i].setZero();
-    P_[i].setZero();
-    P_[i].topLeftCorner<3, 3>() =
-        Eigen::Matrix3d::Identity() * o.initial_sigma_rad * o.initial_sigma_rad;
-    P_[i].bottomRightCorner<2, 2>() = Eigen::Matrix2d::Identity() * sigma_c * sigma_c;
-  }
+  restart(Eigen::Matrix3d::Identity() * o.initial_sigma_rad * o.initial_sigma_rad);
   return Status::ok();
 }
 
