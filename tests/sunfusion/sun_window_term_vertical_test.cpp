@@ -156,9 +156,9 @@ TEST_F(SunWindowTermTest, AStandingTiltTheCueEvidencesWidensTheTiltCovarianceOnl
 
 // The likelihood rule for the tilt (kLikelihood): a standing 2 deg tilt error, which precise
 // answers show and no walk in the bank explains slowly, takes q_tilt to the top of its range
-// (0.05 deg/frame, measured) and leaves the heading's walk alone; answers that agree with VO keep
-// it low (0.0088 measured: the prior's start, 0.0045, over the noise scale at the bottom of its
-// range, where exact answers put it).
+// (the cap, 0.2 deg/frame, measured) and leaves the heading's walk alone; answers that agree with
+// VO keep it low (0.0081 measured, 0.0088 with the cap at 0.05: the prior's start, 0.0043, over
+// the noise scale at the bottom of its range, where exact answers put it).
 TEST_F(SunWindowTermTest, TheCueInnovationsChooseTheTiltWalkFromTheBank) {
   const SunFusionOptions opt = standingTiltOptions(VerticalDriftAdaptation::kLikelihood);
   SunWindowTerm term;

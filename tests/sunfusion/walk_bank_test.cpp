@@ -349,8 +349,8 @@ TEST(WalkBank, AHeadingBankToldTheTiltByTheCueReadsTheWalkCloser) {
 
 // An error removed from outside (the fusion's levelled start): answers that saw an error growing
 // by 0.1 deg/frame, against 1 deg answers, make the fast walks the likely ones; restart() returns
-// the bank to a fresh one's walk and member weights, its members at zero with the given covariance
-// (the next answer's innovation at zero is the same for every member).
+// the bank to a fresh one's walk and member weights, its members at zero with the given
+// covariance.
 TEST(WalkBank, ARestartForgetsTheErrorThatWasRemoved) {
   WalkBank fresh;
   WalkBank bank;
@@ -371,7 +371,7 @@ TEST(WalkBank, ARestartForgetsTheErrorThatWasRemoved) {
   EXPECT_NEAR(bank.tiltWalk(), fresh.tiltWalk(), 1e-12 * fresh.tiltWalk());
   EXPECT_NEAR(bank.walk(), fresh.walk(), 1e-12 * fresh.walk());
   for (int m = 0; m < bank.members(); ++m) EXPECT_NEAR(bank.weight(m), fresh.weight(m), 1e-12);
-  // From then on it reads the answers as a fresh bank whose members start from P_e.
+  // Answers without drift after it keep the walk near the prior's.
   for (int k = 0; k < 20; ++k) {
     bank.propagate(5.0, up);
     bank.update(H, Eigen::Vector3d(n01(rng), n01(rng), 0.0), 2);

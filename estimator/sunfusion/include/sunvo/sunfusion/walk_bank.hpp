@@ -20,11 +20,11 @@
 // estimate by c_w every x becomes x - c_w (a known input: the members stay exact filters).
 // lambda < 1 forgets old answers, so the bank follows a drive whose drift changes. Weights
 // w proportional to exp(l) times a prior 1/q_j (not forgotten): the fusion starts near the slow
-// end (0.0045 deg/frame over the default ranges) and a faster walk must be earned, as the
-// persistence rule's walk sinks under noise alone. q and s are scales, averaged in their
-// logarithms. The fusion weighs each answer with its reported sigma, so the
-// walk it is given keeps the chosen member's ratio of walk to noise: walk() = exp(E[log q - log s])
-// (the same gain as the filter with the chosen walk and the true noise). A walk too slow leaves
+// end (0.0043 deg/frame over the default ranges; 0.0045 with the cap at 0.05) and a faster walk
+// must be earned, as the persistence rule's walk sinks under noise alone. q and s are scales,
+// averaged in their logarithms. The fusion weighs each answer with its reported sigma, so the walk
+// it is given keeps the chosen member's ratio of walk to noise: walk() = exp(E[log q - log s]) (the
+// same gain as the filter with the chosen walk and the true noise). A walk too slow leaves
 // innovations that persist, one too fast pays for its wide S, and a noise scale is told from the
 // walk by how the innovations correlate from answer to answer.
 //
