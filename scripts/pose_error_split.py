@@ -105,9 +105,9 @@ def main():
             w = log_so3(mul(r_gt, transpose(r)))  # C_w,gt = Exp(w) C_w,est
             hd = dot(w, up)
             heading.append(math.degrees(hd))
-            tilt.append(math.degrees(math.sqrt(max(0.0, dot(w, w) - hd * hd))))
+            w_t = [w[i] - hd * up[i] for i in range(3)]  # the tilt part
+            tilt.append(math.degrees(math.sqrt(dot(w_t, w_t))))
             if k < len(steps):
-                w_t = [w[i] - hd * up[i] for i in range(3)]
                 built -= dot(cross(w_t, steps[k]), up)
             c_c_w = transpose(r_gt)
             for i in range(3):

@@ -73,9 +73,7 @@ void SunWindowTerm::adaptDrift(const Innovation& inn, const Eigen::Matrix3d& C_w
           Eigen::Matrix<double, 3, 2> H_c;
           const int rows = bankAnswer(inn, C_w_b, &H, &r_as_came, &H_c);
           tilt_bank_.update(H, H_c, r_as_came, rows);
-          drift_deg_per_frame_ =
-              std::clamp(tilt_bank_.walk() / kDeg, options_.min_drift_deg_per_frame,
-                         options_.vertical_max_drift_deg_per_frame);
+          drift_deg_per_frame_ = bankTiltDrift();
         } else if (channel == 1) {
           vertical_in_sums_ = true;
           std::size_t tilt_rank = 0;
@@ -139,6 +137,11 @@ double SunWindowTerm::stepDrift(double q, double step, double cap) const {
   const double next = q * std::exp(step);
   const double upper = step > 0.0 ? std::max(cap, q) : next;
   return std::max(std::min(next, upper), options_.min_drift_deg_per_frame);
+}
+
+double SunWindowTerm::bankTiltDrift() const {
+  return std::clamp(tilt_bank_.walk() / kDeg, options_.min_drift_deg_per_frame,
+                    options_.vertical_max_drift_deg_per_frame);
 }
 
 bool SunWindowTerm::tiltByEvidence() const {

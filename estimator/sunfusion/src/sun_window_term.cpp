@@ -414,8 +414,7 @@ std::optional<Eigen::Vector3d> SunWindowTerm::takeStartLevelling(std::uint64_t s
     // The tilt's bank chose its walk on answers that saw the start error; it starts again from
     // what the levelling left (P's tilt part) and its prior's walk.
     tilt_bank_.restart(P());
-    drift_deg_per_frame_ = std::clamp(tilt_bank_.walk() / kDeg, options_.min_drift_deg_per_frame,
-                                      options_.vertical_max_drift_deg_per_frame);
+    drift_deg_per_frame_ = bankTiltDrift();
   }
   if (headingByLikelihood()) heading_bank_.shift(e);
   last_correction_ = {sequence, e, world_up_.used()};

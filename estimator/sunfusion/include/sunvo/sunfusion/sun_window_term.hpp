@@ -322,6 +322,9 @@ class SunWindowTerm {
   // One log-step of a walk q raised by a channel whose evidence may take it up to cap: a step up
   // stops at max(cap, q) (another channel's larger cap is not undone), a step down at the floor.
   double stepDrift(double q, double step, double cap) const;
+  // The tilt's walk the likelihood rule gives the fusion (deg/frame): the bank's, within
+  // [min_drift_deg_per_frame, vertical_max_drift_deg_per_frame].
+  double bankTiltDrift() const;
   // The tilt's walk follows the vertical channel by the evidence rule (kEvidence, split).
   bool tiltByEvidence() const;
   // An answer for a walk bank: H = d r / d e (world) and the Huber-weighted r; a 3-D direction's
