@@ -66,6 +66,19 @@ def cross(a, b):
     return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 
 
+def unit_up(text):
+    """The world's up from "x,y,z", normalised."""
+    up = [float(x) for x in text.split(",")]
+    norm = math.sqrt(dot(up, up))
+    return [x / norm for x in up]
+
+
+def height_from_tilt(w_t, step, up):
+    """The height a tilt error w_t (C_w,gt = Exp(w) C_w,est, its part normal to up) adds to a true
+    step: the step is walked turned by -w_t."""
+    return -dot(cross(w_t, step), up)
+
+
 def rms(values):
     return math.sqrt(sum(x * x for x in values) / len(values))
 
@@ -80,9 +93,7 @@ def main():
     args = parser.parse_args()
     if (args.cue_sigma_deg > 0.0) != (args.answers > 0):
         raise SystemExit("--cue-sigma-deg and --answers go together (both > 0)")
-    up = [float(x) for x in args.up.split(",")]
-    norm = math.sqrt(dot(up, up))
-    up = [x / norm for x in up]
+    up = unit_up(args.up)
     gt = load(args.gt)
     steps = [[b[1][i] - a[1][i] for i in range(3)] for a, b in zip(gt, gt[1:])]
     length = sum(math.sqrt(dot(st, st)) for st in steps)
@@ -108,7 +119,7 @@ def main():
             w_t = [w[i] - hd * up[i] for i in range(3)]  # the tilt part
             tilt.append(math.degrees(math.sqrt(dot(w_t, w_t))))
             if k < len(steps):
-                built -= dot(cross(w_t, steps[k]), up)
+                built += height_from_tilt(w_t, steps[k], up)
             c_c_w = transpose(r_gt)
             for i in range(3):
                 mean_c[i] += math.degrees(dot(c_c_w[i], w)) / len(gt)

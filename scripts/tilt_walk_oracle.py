@@ -22,7 +22,8 @@ import argparse
 import math
 import random
 
-from pose_error_split import cross, dot, load, log_so3, mul, transpose
+from pose_error_split import (cross, dot, height_from_tilt, load, log_so3, mul, transpose,
+                              unit_up)
 
 
 def mat2_inv(a):
@@ -70,16 +71,16 @@ def follow(errors, walks, steps, up, axes, sigma, every, draws, seed):
             sum_sq[d] += r[0] * r[0] + r[1] * r[1]
             if k < len(steps):
                 r3 = [r[0] * axes[0][i] + r[1] * axes[1][i] for i in range(3)]
-                built[d] -= dot(cross(r3, steps[k]), up)
+                built[d] += height_from_tilt(r3, steps[k], up)
     tilt = sum(math.sqrt(v / len(errors)) for v in sum_sq) / draws
     return tilt, math.sqrt(sum(b * b for b in built) / draws)
 
 
-def drift_per_axis(gt, run, span=100):
+def drift_per_axis(gt, w, span=100):
     """VO's attitude drift in the camera's axes: the mean per-frame change of its world error w
-    taken in the camera (C_c_w dw), pitch (x) and roll (z), and what walks around that mean: the
-    RMS over windows of `span` frames of the summed change less its mean, over sqrt(span)."""
-    w = [log_so3(mul(r_gt, transpose(r))) for (r_gt, _), (r, _) in zip(gt, run)]
+    (one per frame of gt) taken in the camera (C_c_w dw), pitch (x) and roll (z), and what walks
+    around that mean: the RMS over windows of `span` frames of the summed change less its mean,
+    over sqrt(span)."""
     sums = [[0.0, 0.0]]
     for k in range(len(w) - 1):
         dw = [w[k + 1][i] - w[k][i] for i in range(3)]
@@ -118,27 +119,25 @@ def main():
         raise SystemExit(f"--walks-deg: not a list of numbers: '{args.walks_deg}'")
     if not grid or min(grid) <= 0.0:
         raise SystemExit("--walks-deg: every walk must be > 0")
-    up = [float(v) for v in args.up.split(",")]
-    norm = math.sqrt(dot(up, up))
-    up = [v / norm for v in up]
+    up = unit_up(args.up)
     axes = plane_axes(up)
     gt, run = load(args.gt), load(args.run)
     if len(run) != len(gt):
         raise SystemExit(f"{args.run}: {len(run)} poses, the ground truth has {len(gt)}")
     steps = [[b[1][i] - a[1][i] for i in range(3)] for a, b in zip(gt, gt[1:])]
+    w_all = [log_so3(mul(r_gt, transpose(r))) for (r_gt, _), (r, _) in zip(gt, run)]
     errors, cam, vo_built = [], [], 0.0
-    for k, ((r_gt, _), (r, _)) in enumerate(zip(gt, run)):
-        w = log_so3(mul(r_gt, transpose(r)))
+    for k, ((r_gt, _), w) in enumerate(zip(gt, w_all)):
         e = [dot(w, axes[0]), dot(w, axes[1])]
         errors.append(e)
         if k < len(steps):
             w3 = [e[0] * axes[0][i] + e[1] * axes[1][i] for i in range(3)]
-            vo_built -= dot(cross(w3, steps[k]), up)
+            vo_built += height_from_tilt(w3, steps[k], up)
         # The camera's x (pitch) and z (roll) axes in the tilt plane: rows of axes * C_w_c.
         cam.append([[dot(axes[i], [r_gt[m][c] for m in range(3)]) for c in (0, 2)]
                     for i in range(2)])
     vo_tilt = math.sqrt(sum(e[0] ** 2 + e[1] ** 2 for e in errors) / len(errors))
-    print(drift_per_axis(gt, run))
+    print(drift_per_axis(gt, w_all))
     print(f"{args.run}: pure VO tilt RMS {math.degrees(vo_tilt):.3f} deg, height built by the "
           f"tilt {vo_built:+.2f} m; cue {args.cue_sigma_deg:g} deg every {args.every} frames, "
           f"{args.draws} draws")
