@@ -50,7 +50,11 @@ Status VerticalSegmentDetector::init(int width, int height, int max_width, doubl
 }
 
 void VerticalSegmentDetector::addPoint(Chain& c, double x, int y) const {
-  const double t = y - c.y_first;
+  // A chain has one point per row from y_first on, so a point's row is its index.
+  const int i = y - c.y_first;
+  if (i < kEndTrimRows) c.head[i] = x;
+  c.tail[i % kEndTrimRows] = x;
+  const double t = i;
   c.n += 1.0;
   c.st += t;
   c.sx += x;
@@ -67,6 +71,20 @@ void VerticalSegmentDetector::finish(int index, double min_length_px,
   free_.push_back(index);
   const int rows = c.y_last - c.y_first;
   if (rows < 2 || c.n < 3.0) return;
+  // Leave the end points out of the sums (header, step 5) when at least 3 remain; the segment
+  // still spans the chain's rows.
+  if (c.n >= 2 * kEndTrimRows + 3) {
+    for (int i = 0; i < kEndTrimRows; ++i) {
+      const double t_head = i, x_head = c.head[i];
+      const double t_tail = rows - i, x_tail = c.tail[(rows - i) % kEndTrimRows];
+      c.n -= 2.0;
+      c.st -= t_head + t_tail;
+      c.sx -= x_head + x_tail;
+      c.stt -= t_head * t_head + t_tail * t_tail;
+      c.stx -= t_head * x_head + t_tail * x_tail;
+      c.sxx -= x_head * x_head + x_tail * x_tail;
+    }
+  }
   const double det = c.n * c.stt - c.st * c.st;
   if (!(det > 0.0)) return;
   const double b = (c.n * c.stx - c.st * c.sx) / det;

@@ -74,7 +74,8 @@ int main(int argc, char** argv) {
     csv.open(csv_path);
     if (!csv) return sunvo::cli::fail(kProgram, "cannot write '" + csv_path + "'");
     csv << "set,frame,valid,reason,candidates,inliers,error_deg,roll_deg,pitch_deg,sigma_deg,"
-           "level_deg,cpu_ms,sigma_strong_deg,error_strong_deg,error_weak_deg\n";
+           "level_deg,cpu_ms,sigma_strong_deg,error_strong_deg,error_weak_deg,true_roll_deg,"
+           "true_pitch_deg\n";
   }
   std::printf(
       "| set | frames | valid | median error [deg] | p90 [deg] | roll / pitch median [deg] | "
@@ -105,6 +106,8 @@ int main(int argc, char** argv) {
       ms.push_back(dt);
       const Eigen::Vector3d truth = f.true_up_c.normalized();
       lev.push_back(angleDeg(level, truth));
+      // The camera's own tilt, the small rotation taking the level up to the truth (same axes).
+      const Eigen::Vector3d tilt = level.cross(truth);
       // Small rotation taking the truth to the estimate, camera axes: z = roll, x = pitch.
       const Eigen::Vector3d e = truth.cross(m->up_c);
       const double a = angleDeg(m->up_c, truth);
@@ -126,7 +129,8 @@ int main(int argc, char** argv) {
         csv << ds->name << ',' << k << ',' << (m->valid ? 1 : 0) << ',' << m->reason << ','
             << m->candidates << ',' << m->inliers << ',' << a << ',' << e.z() / kDeg << ','
             << e.x() / kDeg << ',' << m->sigma_rad / kDeg << ',' << lev.back() << ',' << dt << ','
-            << m->sigma_strong_rad / kDeg << ',' << e_strong / kDeg << ',' << e_weak / kDeg << '\n';
+            << m->sigma_strong_rad / kDeg << ',' << e_strong / kDeg << ',' << e_weak / kDeg << ','
+            << tilt.z() / kDeg << ',' << tilt.x() / kDeg << '\n';
       }
     }
     // A render or raw drive is <set>/<date>/<date>_drive_NNNN_sync: name it by <set>.

@@ -20,7 +20,11 @@
 // 5. An ended chain becomes a segment when it is at least min_length_px long (full-resolution
 //    pixels) and its points' RMS distance from the line is at most kMaxRmsPx: its fitted line
 //    between its first and last rows, in full-resolution pixel coordinates (pixel centres are
-//    integers, so small pixel p is full pixel (p + 0.5) f - 0.5).
+//    integers, so small pixel p is full pixel (p + 0.5) f - 0.5). The line is fitted without the
+//    chain's first and last kEndTrimRows points: an edge ends where it meets another (a window's
+//    corner, a roof line), and its end edgels are pulled toward that edge; in perspective the
+//    pull differs at the two ends, and on short segments it tilted the fit enough to put a
+//    +0.03 ... +0.05 deg pitch bias on the up (docs/vertical.md, "The segments' ends").
 
 #include <cstdint>
 #include <opencv2/core.hpp>
@@ -44,6 +48,7 @@ class VerticalSegmentDetector {
   static constexpr int kMinFitPoints = 8;            // points before a chain's line is trusted
   static constexpr double kMaxStepResidualPx = 1.0;  // small-image px: a farther edgel ends it
   static constexpr double kMaxRmsPx = 0.5;           // small-image px: straightness of a segment
+  static constexpr int kEndTrimRows = 1;             // points left out of the fit at each end
 
   // width, height: the full-resolution image; max_width: columns after downscaling (>= 8);
   // min_gradient: gray levels per pixel (> 0); max_segments: output capacity. Allocates.
@@ -65,6 +70,9 @@ class VerticalSegmentDetector {
     int y_first = 0, y_last = 0;
     int sign = 0;
     bool ended = false;  // an edgel off its line ended it (it takes no more points)
+    // x of its first kEndTrimRows points, and of its last ones (a ring indexed by row).
+    double head[kEndTrimRows] = {};
+    double tail[kEndTrimRows] = {};
   };
   void addPoint(Chain& c, double x, int y) const;
   // Ends chain `index`: appends its segment when it qualifies, frees its slot.
