@@ -64,6 +64,26 @@ TEST_F(VerticalEstimatorTest, FindsTheTrueUpOfARolledAndPitchedCamera) {
   EXPECT_GT(m->sigma_rad, 0.0);
   EXPECT_LT(m->sigma_rad, 1.0 * kDeg);
   EXPECT_NEAR(m->up_c.norm(), 1.0, 1e-12);
+  // The candidates of the call (sunvo_vertical_eval --segments-csv): each plane holds the rays
+  // of its two end points, is as long as they are apart, and about as many lie within the inlier
+  // bound of the truth as of the estimate.
+  int near_truth = 0;
+  for (const auto& p : est.candidates()) {
+    const StereoCamera cam = kittiCamera();
+    const auto ray = [&](const Eigen::Vector2d& q) {
+      return Eigen::Vector3d((q.x() - cam.cu) / cam.fu, (q.y() - cam.cv) / cam.fv, 1.0)
+          .normalized();
+    };
+    EXPECT_NEAR(p.n.norm(), 1.0, 1e-12);
+    EXPECT_NEAR(p.n.dot(ray(p.a)), 0.0, 1e-12);
+    EXPECT_NEAR(p.n.dot(ray(p.b)), 0.0, 1e-12);
+    EXPECT_NEAR(p.w, (p.b - p.a).norm(), 1e-9);
+    if (std::abs(p.n.dot(up_true)) < std::sin(VerticalOptions{}.inlier_angle_deg * kDeg)) {
+      ++near_truth;
+    }
+  }
+  EXPECT_EQ(static_cast<int>(est.candidates().size()), m->candidates);
+  EXPECT_NEAR(near_truth, m->inliers, 2);
   // The level prior is 3.6 deg off; a prior at the truth gives the same answer.
   auto again = est.estimate(street(C_c_w, -15.0, 15.0, 30), up_true);
   ASSERT_TRUE(again && again->valid);

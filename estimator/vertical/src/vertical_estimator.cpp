@@ -161,7 +161,7 @@ Expected<VerticalMeasurement> VerticalEstimator::estimate(const cv::Mat& gray,
     if (!(norm > 0.0) || !n.allFinite()) continue;
     const Eigen::Vector3d nu = n / norm;
     if (std::abs(nu.dot(prior)) >= tilt_bound) continue;
-    planes_.push_back({nu, len});
+    planes_.push_back({nu, len, a, b});
   }
   out.candidates = static_cast<int>(planes_.size());
   if (out.candidates < options_.min_inliers) {

@@ -6,10 +6,15 @@
 // 90th percentile of the angle between the estimated and true up, the median signed roll (about
 // the optical axis) and pitch (about the camera's x) of that error, the share within 2 sigma,
 // the median angle of the level prior itself, and CPU ms per call. One Markdown row per set on
-// stdout; --csv FILE writes one line per frame. Exit codes: 0 done, 1 a set or image failed,
+// stdout; --csv FILE writes one line per frame; --segments-csv FILE one line per candidate segment
+// of a valid frame: whether it is an inlier of the estimate, its interpretation plane's signed
+// angle from the true up and from the estimate (deg: a segment that leans toward the image's
+// centre at its top reads as a pitch), x0 = the plane's column at the principal row (normalised,
+// (u - cu) / fu) and its end points in pixels. Exit codes: 0 done, 1 a set or image failed,
 // 2 bad arguments.
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <ctime>
@@ -43,7 +48,7 @@ double angleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
 
 int main(int argc, char** argv) {
   std::vector<std::string> sets;
-  std::string csv_path;
+  std::string csv_path, segments_path;
   int max_frames = 0, every = 1;
   sunvo::vertical::VerticalOptions options;
   CLI::App app{"Vertical vanishing point (gravity cue) against the true up, per image set.",
@@ -54,6 +59,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0, 1000000));
   app.add_option("--every", every, "every N-th frame")->check(CLI::Range(1, 100000));
   app.add_option("--csv", csv_path, "per-frame CSV");
+  app.add_option("--segments-csv", segments_path, "per-segment CSV of the valid frames");
   app.add_option("--max-width-px", options.max_width_px,
                  "wider images are downscaled to this width first, px");
   app.add_option("--inlier-angle-deg", options.inlier_angle_deg, "inlier bound, deg");
@@ -76,6 +82,12 @@ int main(int argc, char** argv) {
     csv << "set,frame,valid,reason,candidates,inliers,error_deg,roll_deg,pitch_deg,sigma_deg,"
            "level_deg,cpu_ms,sigma_strong_deg,error_strong_deg,error_weak_deg,true_roll_deg,"
            "true_pitch_deg\n";
+  }
+  std::ofstream seg_csv;
+  if (!segments_path.empty()) {
+    seg_csv.open(segments_path);
+    if (!seg_csv) return sunvo::cli::fail(kProgram, "cannot write '" + segments_path + "'");
+    seg_csv << "set,frame,inlier,true_deg,est_deg,x0,length_px,ua,va,ub,vb\n";
   }
   std::printf(
       "| set | frames | valid | median error [deg] | p90 [deg] | roll / pitch median [deg] | "
@@ -124,6 +136,19 @@ int main(int argc, char** argv) {
         roll.push_back(e.z() / kDeg);
         pitch.push_back(e.x() / kDeg);
         if (a * kDeg < 2.0 * m->sigma_rad) ++within;
+      }
+      if (seg_csv.is_open() && m->valid) {
+        const double inlier_bound = std::sin(options.inlier_angle_deg * kDeg);
+        for (const auto& p : estimator.candidates()) {
+          // The normal's sign: n.x > 0, so that the signed angles compare across segments.
+          const Eigen::Vector3d nu = p.n.x() < 0.0 ? Eigen::Vector3d(-p.n) : p.n;
+          const double x0 = std::abs(nu.x()) > 1e-12 ? -nu.z() / nu.x() : 0.0;
+          seg_csv << ds->name << ',' << k << ',' << (std::abs(nu.dot(m->up_c)) < inlier_bound)
+                  << ',' << std::asin(std::clamp(nu.dot(truth), -1.0, 1.0)) / kDeg << ','
+                  << std::asin(std::clamp(nu.dot(m->up_c), -1.0, 1.0)) / kDeg << ',' << x0 << ','
+                  << p.w << ',' << p.a.x() << ',' << p.a.y() << ',' << p.b.x() << ',' << p.b.y()
+                  << '\n';
+        }
       }
       if (csv.is_open()) {
         csv << ds->name << ',' << k << ',' << (m->valid ? 1 : 0) << ',' << m->reason << ','

@@ -117,11 +117,17 @@ class VerticalEstimator {
   // valid = false and a reason. Never NaN.
   Expected<VerticalMeasurement> estimate(const cv::Mat& gray, const Eigen::Vector3d& up_prior_c);
 
- private:
+  // A candidate segment of the last estimate(): the unit normal of its interpretation plane
+  // (camera frame), its length (the weight, full-resolution px) and its end points (full
+  // resolution px). For diagnosis (sunvo_vertical_eval --segments-csv).
   struct Plane {
     Eigen::Vector3d n;
     double w;
+    Eigen::Vector2d a, b;
   };
+  const std::vector<Plane>& candidates() const { return planes_; }
+
+ private:
   // up = the smallest eigenvector of the weighted scatter of the planes with |n . up| < bound;
   // returns false when fewer than 3 planes qualify.
   // sigma: the worse tangent direction's 1-sigma angle; sigma_strong and strong_axis: the better
