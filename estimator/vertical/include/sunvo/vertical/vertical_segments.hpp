@@ -24,7 +24,7 @@
 //    chain's first and last kEndTrimRows points: an edge ends where it meets another (a window's
 //    corner, a roof line), and its end edgels are pulled toward that edge; in perspective the
 //    pull differs at the two ends, and on short segments it tilted the fit enough to put a
-//    +0.03 ... +0.05 deg pitch bias on the up (docs/vertical.md, "The segments' ends").
+//    +0.03 ... +0.05 deg pitch bias on the up (docs/vertical_ends.md).
 
 #include <cstdint>
 #include <opencv2/core.hpp>
